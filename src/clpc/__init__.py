@@ -1,0 +1,39 @@
+"""clpc - system identification with Last Principal Components (LPC) and Cluster LPC.
+
+The LPC estimator fits a linear difference equation ``A(q) y + B(q) u = r`` to measured
+input/output data by total least squares (the eigenvector of the smallest eigenvalue of the
+centered scatter matrix of lag vectors); CLPC runs it window by window as a finite-state
+machine and reports time-varying parameters and the degree of linearity of each cluster.
+"""
+
+from .arx import ARX, simulate_arx
+from .data import DataError, IOData, as_iodata
+from .lpc import LPC, lpc_solve
+from .metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
+from .model import LinearModel, ModelError
+from .order import OrderSelection, select_order
+from .regressors import Structure
+from .solve import RobustRule
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ARX",
+    "LPC",
+    "DataError",
+    "IOData",
+    "LinearModel",
+    "ModelError",
+    "OrderSelection",
+    "RobustRule",
+    "Structure",
+    "as_iodata",
+    "fit_percent",
+    "kstep_fit",
+    "lpc_solve",
+    "rmse",
+    "select_order",
+    "simulate_arx",
+    "vaf",
+    "whiteness_test",
+]

@@ -1,0 +1,103 @@
+"""Baseline: ordinary least-squares ARX with the same structure as LPC.
+
+Least squares assumes the noise is on ``y(n)`` only (equation error); with noise on both
+input and output it is biased, which is where LPC (total least squares) earns its keep.
+The model is returned in the same :class:`~clpc.model.LinearModel` as LPC, so the two can be
+put side by side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from .data import as_iodata
+from .model import LinearModel
+from .regressors import MimoMode, Structure, check_mode, default_mode, regressors
+
+__all__ = ["ARX", "simulate_arx"]
+
+
+@dataclass
+class ARX:
+    """Least-squares ARX: minimise ``sum (y(n) - phi_n^T x - k)^2``.
+
+    Parameters
+    ----------
+    order, na, nb, nk, mimo
+        As for :class:`clpc.LPC` (same structure, same lag matrices).
+    """
+
+    order: int = 2
+    na: int | None = None
+    nb: int | None = None
+    nk: int = 0
+    mimo: MimoMode | None = None
+
+    def structure(self) -> Structure:
+        """The :class:`Structure` these settings describe."""
+        if self.na is None and self.nb is None:
+            return Structure.from_order(self.order, self.nk)
+        return Structure(
+            self.order if self.na is None else self.na,
+            self.order if self.nb is None else self.nb,
+            self.nk,
+        )
+
+    def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
+        """Least-squares fit; returns a :class:`LinearModel` (``theta`` unit norm, a0 > 0)."""
+        data = as_iodata(u, y, dt)
+        structure = self.structure()
+        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
+        check_mode(mode, data.n_inputs, data.n_outputs)
+        n_blocks = data.n_inputs if mode == "miso" else 1
+        p = structure.n_params(n_blocks)
+        data.require_samples(structure.max_lag + p + 1, f"An ARX fit with {p} parameters")
+        mats = regressors(data, structure, mode)
+        mean = mats.mean(axis=1)
+        thetas = np.empty((mats.shape[0], mats.shape[2]))
+        for j, (m, z) in enumerate(zip(mats, mean, strict=False)):
+            centered = m - z
+            # y(n) = -[a1..; b..] . rest  ->  theta = [1, x]
+            x, *_ = np.linalg.lstsq(centered[:, 1:], -centered[:, 0], rcond=None)
+            thetas[j] = np.concatenate([[1.0], x])
+        thetas /= np.linalg.norm(thetas, axis=1, keepdims=True)
+        c = np.einsum("kp,kp->k", mean, thetas)
+        return LinearModel(
+            theta=thetas,
+            structure=structure,
+            n_inputs=data.n_inputs,
+            mode=mode,
+            c=c,
+            dt=data.dt,
+            input_names=data.input_names,
+            output_names=data.output_names,
+            info={"method": "least-squares"},
+        )
+
+
+def simulate_arx(den: Any, num: Any, u: Any, noise: Any | None = None) -> np.ndarray:
+    """Simulate ``A(q) y = B(q) u + e`` with monic ``den`` and ``num`` (ascending ``z^-1``).
+
+    Parameters
+    ----------
+    den : array_like, shape (na + 1,)
+        ``[1, a1, ..., a_na]``.
+    num : array_like, shape (nb + 1,)
+        ``[b0, ..., b_nb]`` (leading zeros for a delay).
+    u : array_like, shape (T,)
+        Input.
+    noise : array_like, shape (T,), optional
+        Equation error ``e``.
+
+    Returns
+    -------
+    ndarray, shape (T,)
+    """
+    y = signal.lfilter(np.asarray(num, float), np.asarray(den, float), np.asarray(u, float))
+    if noise is not None:
+        y = y + signal.lfilter([1.0], np.asarray(den, float), np.asarray(noise, float))
+    return y

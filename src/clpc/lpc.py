@@ -1,0 +1,246 @@
+"""The LPC estimator (paper sections II-IV): one solve over a whole record.
+
+>>> import numpy as np, clpc
+>>> rng = np.random.default_rng(0)
+>>> u = rng.standard_normal(2000)
+>>> y = clpc.simulate_arx([1, -0.5], [0, 1.0], u)            # y(n) = 0.5 y(n-1) + u(n-1)
+>>> model = clpc.LPC(order=1).fit(u, y, dt=0.01)
+>>> np.round(model.den, 6).tolist(), np.round(model.num, 6).tolist()
+([1.0, -0.5], [0.0, 1.0])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .data import DataError, IOData, as_iodata
+from .model import LinearModel
+from .regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from .solve import RobustRule, SolveResult, index_j, log_likelihood, solve_scatter
+
+__all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
+
+
+def structure_blocks(structure: Structure, n_input_blocks: int) -> list[slice]:
+    """Column slices of one lag vector: the output block, then one block per input."""
+    na1, nb1 = structure.na + 1, structure.nb + 1
+    return [slice(0, na1)] + [
+        slice(na1 + i * nb1, na1 + (i + 1) * nb1) for i in range(n_input_blocks)
+    ]
+
+
+def lpc_solve(
+    matrices: np.ndarray,
+    *,
+    n_output_cols: int,
+    blocks: list[slice],
+    method: str = "robust",
+    noise_cov: np.ndarray | None = None,
+    rule: RobustRule | None = None,
+) -> SolveResult:
+    """LPC of one or more lag matrices (rows are lag vectors ``z_n``).
+
+    Parameters
+    ----------
+    matrices : ndarray, shape (k, n_rows, p)
+        Lag matrices (paper eq. 36), e.g. from :func:`clpc.regressors.regressors`.
+    n_output_cols, blocks, method, noise_cov, rule
+        See :func:`clpc.solve.solve_scatter`.
+
+    Returns
+    -------
+    SolveResult
+        The centering (eqs. 24-25) is two-pass and the decomposition is the SVD of the
+        centered data, so large offsets (e.g. positions around 1e4 rad) lose no digits.
+    """
+    mats = np.asarray(matrices, dtype=np.float64)
+    mean = mats.mean(axis=1)
+    centered = mats - mean[:, None, :]
+    scatter = np.swapaxes(centered, 1, 2) @ centered  # eq. 27
+    n_rows = np.full(mats.shape[0], mats.shape[1])
+    return solve_scatter(
+        scatter,
+        mean,
+        n_rows,
+        n_output_cols=n_output_cols,
+        blocks=blocks,
+        method=method,
+        noise_cov=noise_cov,
+        rule=rule,
+        data=centered,
+    )
+
+
+def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str, np.ndarray]:
+    """Statistics of a solve as plain arrays (one entry per equation or window).
+
+    Keys: ``eigenvalues``, ``lambda_min``, ``lambda_max``, ``D`` (``lambda_max -
+    lambda_min``, the paper's degree of linearity), ``eig_ratio`` (``lambda_min /
+    lambda_max``, scale-free), ``separation``, ``c``, ``noise_variance``,
+    ``log_likelihood``, ``J`` (eq. 22), ``n_rows``, ``n_null``, ``n_input_relations``,
+    ``degenerate``, ``determined``.
+    """
+    vals = res.eigenvalues
+    lam_min, lam_max = vals[:, 0], vals[:, -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(lam_max > 0, lam_min / np.where(lam_max > 0, lam_max, 1.0), 1.0)
+    determined = (
+        (res.n_null == 1)
+        & (res.n_input_relations == 0)
+        & (res.separation <= rule.separation)
+        & ~res.degenerate
+    )
+    return {
+        "eigenvalues": vals,
+        "lambda_min": lam_min,
+        "lambda_max": lam_max,
+        "D": lam_max - lam_min,
+        "eig_ratio": ratio,
+        "separation": res.separation,
+        "c": res.c,
+        "noise_variance": res.noise_variance,
+        "log_likelihood": log_likelihood(res.noise_variance, n_rows),
+        "J": index_j(res.noise_variance, n_rows),
+        "n_rows": np.asarray(n_rows),
+        "n_null": res.n_null,
+        "n_input_relations": res.n_input_relations,
+        "degenerate": res.degenerate,
+        "determined": determined,
+    }
+
+
+@dataclass
+class LPC:
+    """Last Principal Component estimator (paper sections II-IV).
+
+    Parameters
+    ----------
+    order : int
+        The paper's ``N`` (``parameters_size - 1``): ``na = nb = order``. Default 2.
+    na, nb : int, optional
+        Separate output / input orders (override ``order``).
+    nk : int
+        Input delay in samples (default 0: ``b0`` present, as in the paper).
+    method : {"robust", "paper"}
+        ``"paper"``: the literal smallest eigenvector of the scatter matrix.
+        ``"robust"`` (default): unit-free scaling and the excitation-aware nongeneric
+        TLS solution (see :mod:`clpc.solve`).
+    mimo : {"siso", "paired", "miso"}, optional
+        Multi-channel structure; default ``"siso"`` for 1x1 data, else ``"miso"``.
+        ``"paired"`` is the paper's eqs. 35-38 (output j on input j only).
+    noise_ratio : float, optional
+        Known ratio ``var(input noise) / var(output noise)`` (weighted LPC).
+    noise_cov : array_like, shape (p,) or (p, p), optional
+        Known noise covariance of the lag vector (weighted LPC; overrides
+        ``noise_ratio``).
+    rule : RobustRule, optional
+        Thresholds of the robust solution.
+
+    Notes
+    -----
+    Constructor arguments are only stored; they are checked by :meth:`fit`.
+    """
+
+    order: int = 2
+    na: int | None = None
+    nb: int | None = None
+    nk: int = 0
+    method: str = "robust"
+    mimo: MimoMode | None = None
+    noise_ratio: float | None = None
+    noise_cov: Any = None
+    rule: RobustRule | None = None
+
+    def structure(self) -> Structure:
+        """The :class:`Structure` these settings describe."""
+        if self.na is None and self.nb is None:
+            return Structure.from_order(self.order, self.nk)
+        return Structure(
+            self.order if self.na is None else self.na,
+            self.order if self.nb is None else self.nb,
+            self.nk,
+        )
+
+    def _noise_cov(self, structure: Structure, n_blocks: int) -> np.ndarray | None:
+        if self.noise_cov is not None:
+            return np.asarray(self.noise_cov, dtype=np.float64)
+        if self.noise_ratio is None:
+            return None
+        ratio = float(self.noise_ratio)
+        if not np.isfinite(ratio) or ratio <= 0:
+            raise ValueError(
+                f"noise_ratio (input/output noise variance) must be > 0; got {self.noise_ratio!r}."
+            )
+        return np.concatenate(
+            [np.ones(structure.na + 1), np.full(n_blocks * (structure.nb + 1), ratio)]
+        )
+
+    def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
+        """Identify the model from a record.
+
+        Parameters
+        ----------
+        u : IOData or array_like, shape (T,) or (T, n_inputs)
+            The record, or its inputs.
+        y : array_like, shape (T,) or (T, n_outputs), optional
+            Outputs (when ``u`` is not an :class:`IOData`).
+        dt : float, optional
+            Sample time [s].
+
+        Returns
+        -------
+        LinearModel
+            With ``info`` holding the statistics of :func:`fit_info` per output.
+
+        Raises
+        ------
+        DataError
+            Invalid data, too few samples, or a record in which nothing varies.
+        """
+        data = as_iodata(u, y, dt)
+        structure = self.structure()
+        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
+        check_mode(mode, data.n_inputs, data.n_outputs)
+        n_blocks = data.n_inputs if mode == "miso" else 1
+        p = structure.n_params(n_blocks)
+        data.require_samples(structure.max_lag + p + 1, f"An LPC fit with {p} parameters")
+        mats = regressors(data, structure, mode)
+        rule = self.rule or RobustRule()
+        res = lpc_solve(
+            mats,
+            n_output_cols=structure.na + 1,
+            blocks=structure_blocks(structure, n_blocks),
+            method=self.method,
+            noise_cov=self._noise_cov(structure, n_blocks),
+            rule=rule,
+        )
+        _raise_if_degenerate(res, data)
+        info = fit_info(res, np.full(mats.shape[0], mats.shape[1]), rule)
+        info["method"] = self.method
+        return LinearModel(
+            theta=res.theta,
+            structure=structure,
+            n_inputs=data.n_inputs,
+            mode=mode,
+            c=res.c,
+            dt=data.dt,
+            input_names=data.input_names,
+            output_names=data.output_names,
+            info=info,
+        )
+
+
+def _raise_if_degenerate(res: SolveResult, data: IOData) -> None:
+    if not np.any(res.degenerate):
+        return
+    j = int(np.argmax(res.degenerate))
+    const = [n for n, col in zip(data.input_names, data.u.T, strict=False) if np.ptp(col) == 0]
+    const += [n for n, col in zip(data.output_names, data.y.T, strict=False) if np.ptp(col) == 0]
+    what = f"constant channel(s) {const}" if const else "no variation in the lag vectors"
+    raise DataError(
+        f"nothing to identify for output {j}: {what}. LPC needs inputs and outputs that "
+        "vary over the record."
+    )

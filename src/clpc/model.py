@@ -1,0 +1,407 @@
+"""The identified model: a linear difference equation in two conventions.
+
+Paper convention (eqs. 17, 35): the unit-norm parameter vector ``theta = [a; b]`` with
+
+    a0 y(n) + a1 y(n-1) + ... + a_na y(n-na) + b0 u(n-nk) + ... + b_nb u(n-nk-nb) = r(n),
+
+``E[r] = c``. Moving the input to the right-hand side gives ``A(z) Y = -B(z) U + c``, so the
+transfer function is ``G(z) = -B(z)/A(z)`` (the paper's eq. 34 drops this minus sign).
+
+Engineering convention (monic, ascending powers of ``z^-1``, ready for
+``scipy.signal.lfilter(num, den, u)``)::
+
+    den = [1, a1/a0, ..., a_na/a0]
+    num = [0]*nk + [-b0/a0, ..., -b_nb/a0]
+    intercept = c/a0                      # y(n) + ... = num * u + intercept + e(n)
+
+One output per equation; equation ``j`` has one numerator per input (``"paired"`` MIMO
+models keep only input ``j``; the others are zero).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from .regressors import Structure
+
+__all__ = ["LinearModel", "ModelError"]
+
+
+class ModelError(ValueError):
+    """The requested operation does not exist for this model (e.g. an unstable inverse)."""
+
+
+def _as_2d(x: Any, n_cols: int, name: str) -> tuple[np.ndarray, bool]:
+    arr = np.asarray(x, dtype=np.float64)
+    was_1d = arr.ndim == 1
+    if was_1d:
+        arr = arr[:, None]
+    if arr.ndim != 2 or arr.shape[1] != n_cols:
+        raise ValueError(
+            f"{name} must have shape (n_samples,) or (n_samples, {n_cols}); got {arr.shape}."
+        )
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
+        raise ValueError(f"{name} must be finite; the first non-finite sample is at {bad}.")
+    return arr, was_1d
+
+
+@dataclass(frozen=True, eq=False)
+class LinearModel:
+    """A (multi-)output linear model ``A_j(q) y_j = sum_i Bn_ji(q) u_i + k_j + e_j``.
+
+    Parameters
+    ----------
+    theta : ndarray, shape (n_outputs, p)
+        Unit-norm parameter vectors, one per output (paper convention).
+    structure : Structure
+        Orders and delay.
+    n_inputs : int
+        Number of inputs.
+    mode : {"siso", "paired", "miso"}
+        How outputs relate to inputs.
+    c : ndarray, shape (n_outputs,)
+        Mean of the equation error ``r`` (eq. 24).
+    dt : float
+        Sample time [s].
+    input_names, output_names : tuple of str
+        Channel names.
+    info : dict
+        Fit statistics (eigenvalues, D, noise variance, J, verdict...) per output.
+    """
+
+    theta: np.ndarray
+    structure: Structure
+    n_inputs: int
+    mode: str
+    c: np.ndarray
+    dt: float = 1.0
+    input_names: tuple[str, ...] = ("u",)
+    output_names: tuple[str, ...] = ("y",)
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        theta = np.atleast_2d(np.asarray(self.theta, dtype=np.float64))
+        object.__setattr__(self, "theta", theta)
+        object.__setattr__(self, "c", np.atleast_1d(np.asarray(self.c, dtype=np.float64)))
+
+    # ----------------------------------------------------------------- conventions
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs (equations)."""
+        return int(self.theta.shape[0])
+
+    @property
+    def is_siso(self) -> bool:
+        """One input and one output."""
+        return self.n_outputs == 1 and self.n_inputs == 1
+
+    def _a0(self) -> np.ndarray:
+        a0 = self.theta[:, 0]
+        scale = np.linalg.norm(self.theta, axis=1)
+        if np.any(np.abs(a0) <= 1e-12 * np.maximum(scale, 1e-300)):
+            j = int(np.argmin(np.abs(a0)))
+            raise ModelError(
+                f"a0 of output {j} is about 0 (theta={self.theta[j].round(6).tolist()}): the "
+                "data do not determine y(n), so the monic transfer function does not exist. "
+                "Check the excitation or lower the order."
+            )
+        return a0
+
+    @property
+    def denominators(self) -> np.ndarray:
+        """Monic ``A_j(z)`` coefficients, ascending powers of ``z^-1``: shape (n_out, na+1)."""
+        na = self.structure.na
+        return self.theta[:, : na + 1] / self._a0()[:, None]
+
+    @property
+    def numerators(self) -> np.ndarray:
+        """``-B_ji(z)/a0`` with ``nk`` leading zeros: shape (n_out, n_in, nk+nb+1)."""
+        s = self.structure
+        a0 = self._a0()
+        n_out = self.n_outputs
+        nums = np.zeros((n_out, self.n_inputs, s.nk + s.nb + 1))
+        for j in range(n_out):
+            b = self.theta[j, s.na + 1 :].reshape(-1, s.nb + 1)
+            cols = [j] if self.mode == "paired" else list(range(self.n_inputs))
+            for blk, i in enumerate(cols):
+                nums[j, i, s.nk :] = -b[blk] / a0[j]
+        return nums
+
+    @property
+    def intercept(self) -> np.ndarray:
+        """Constant term ``c/a0`` of the monic equation, shape (n_outputs,)."""
+        return self.c / self._a0()
+
+    def _siso(self, what: str) -> None:
+        if not self.is_siso:
+            raise ModelError(
+                f"{what} is defined for single-input single-output models; this model has "
+                f"{self.n_inputs} input(s) and {self.n_outputs} output(s). "
+                "Use numerators/denominators or to_control()."
+            )
+
+    @property
+    def num(self) -> np.ndarray:
+        """SISO numerator ``-B(z)/a0``, ascending powers of ``z^-1``, shape (nk+nb+1,)."""
+        self._siso("num")
+        return self.numerators[0, 0]
+
+    @property
+    def den(self) -> np.ndarray:
+        """SISO monic denominator ``A(z)/a0``, ascending powers of ``z^-1``, shape (na+1,)."""
+        self._siso("den")
+        return self.denominators[0]
+
+    # ----------------------------------------------------------------- analysis
+    def poles(self, output: int = 0) -> np.ndarray:
+        """Poles (roots of ``z^na A(z)``) of output ``output``'s equation."""
+        return np.roots(self.denominators[output])
+
+    def zeros(self, output: int = 0, input: int = 0) -> np.ndarray:
+        """Finite zeros of ``G_{output,input}(z)`` (leading zero coefficients dropped)."""
+        num = np.trim_zeros(self.numerators[output, input], "f")
+        return np.roots(num) if num.size > 1 else np.array([])
+
+    @property
+    def is_stable(self) -> bool:
+        """All poles strictly inside the unit circle."""
+        return all(np.all(np.abs(self.poles(j)) < 1.0) for j in range(self.n_outputs))
+
+    def dc_gain(self) -> np.ndarray:
+        """Static gains ``G(1)``, shape (n_outputs, n_inputs); ``inf`` for an integrator."""
+        den_sum = self.denominators.sum(axis=1)[:, None]
+        num_sum = self.numerators.sum(axis=2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gain = num_sum / den_sum
+        return np.where(np.abs(den_sum) < 1e-12, np.inf * np.sign(num_sum + 0.0), gain)
+
+    def frequency_response(
+        self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Frequency response ``G(e^{j w dt})``.
+
+        Parameters
+        ----------
+        freqs : int or ndarray
+            Number of frequencies up to Nyquist, or frequencies [Hz].
+        output, input : int
+            Channel pair.
+
+        Returns
+        -------
+        freqs_hz : ndarray, shape (n_freqs,)
+            Frequencies [Hz] (per sample when ``dt = 1``).
+        response : ndarray of complex, shape (n_freqs,)
+        """
+        fs = 1.0 / self.dt
+        w, h = signal.freqz(
+            self.numerators[output, input], self.denominators[output], worN=freqs, fs=fs
+        )
+        return w, h
+
+    # ----------------------------------------------------------------- time domain
+    def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
+        """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
+        nums = self.numerators
+        n_lag = nums.shape[2] - 1
+        if u_init is None:
+            u_ext = np.vstack([np.zeros((n_lag, self.n_inputs)), u])
+        else:
+            u0, _ = _as_2d(u_init, self.n_inputs, "u_init")
+            if u0.shape[0] < n_lag:
+                raise ValueError(f"u_init must hold the last {n_lag} inputs before u[0].")
+            u_ext = np.vstack([u0[u0.shape[0] - n_lag :], u])
+        x = np.empty((u.shape[0], self.n_outputs))
+        for j in range(self.n_outputs):
+            acc = np.zeros(u_ext.shape[0])
+            for i in range(self.n_inputs):
+                acc += signal.lfilter(nums[j, i], [1.0], u_ext[:, i])
+            x[:, j] = acc[n_lag:]
+        return x
+
+    def simulate(
+        self,
+        u: Any,
+        *,
+        y_init: Any | None = None,
+        u_init: Any | None = None,
+        include_offset: bool = True,
+    ) -> np.ndarray:
+        """Free-run simulation from the input alone.
+
+        Parameters
+        ----------
+        u : array_like, shape (T,) or (T, n_inputs)
+            Input samples.
+        y_init : array_like, shape (na,) or (na, n_outputs), optional
+            The ``na`` outputs just before ``u[0]``, oldest first. Default: zeros.
+        u_init : array_like, shape (nk+nb,) or (nk+nb, n_inputs), optional
+            The inputs just before ``u[0]``, oldest first. Default: zeros.
+        include_offset : bool
+            Add the identified constant ``c/a0`` (default). ``False`` simulates the
+            deviation model ``lfilter(num, den, u)`` exactly.
+
+        Returns
+        -------
+        ndarray, shape (T,) for a SISO model given 1-D ``u``, else (T, n_outputs)
+        """
+        u2, was_1d = _as_2d(u, self.n_inputs, "u")
+        x = self._forced(u2, u_init)
+        if include_offset:
+            x = x + self.intercept[None, :]
+        dens = self.denominators
+        na = self.structure.na
+        y0 = None
+        if y_init is not None:
+            y0, _ = _as_2d(y_init, self.n_outputs, "y_init")
+            if y0.shape[0] < na:
+                raise ValueError(f"y_init must hold the last {na} outputs before u[0].")
+            y0 = y0[y0.shape[0] - na :]
+        y = np.empty_like(x)
+        for j in range(self.n_outputs):
+            zi = None
+            if y0 is not None:
+                zi = signal.lfiltic([1.0], dens[j], y0[::-1, j])
+            if zi is None:
+                y[:, j] = signal.lfilter([1.0], dens[j], x[:, j])
+            else:
+                y[:, j] = signal.lfilter([1.0], dens[j], x[:, j], zi=zi)[0]
+        return y[:, 0] if (was_1d and self.n_outputs == 1) else y
+
+    def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
+        """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
+
+        Each prediction uses measured outputs up to ``n - k`` and the model for the rest
+        (for ``k = 1`` the one-step-ahead predictor of the equation). The first
+        ``max_lag`` samples have no complete past and are returned as measured.
+
+        Parameters
+        ----------
+        u : array_like, shape (T,) or (T, n_inputs)
+        y : array_like, shape (T,) or (T, n_outputs)
+        k : int
+            Prediction horizon in samples (>= 1).
+
+        Returns
+        -------
+        ndarray, same shape as ``y``
+        """
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
+        u2, _ = _as_2d(u, self.n_inputs, "u")
+        y2, y_1d = _as_2d(y, self.n_outputs, "y")
+        if u2.shape[0] != y2.shape[0]:
+            raise ValueError(
+                f"u and y must have the same length; got len(u)={u2.shape[0]}, "
+                f"len(y)={y2.shape[0]}."
+            )
+        start = self.structure.max_lag
+        x = self._forced(u2, None) + self.intercept[None, :]
+        dens = self.denominators
+        na = self.structure.na
+        n = y2.shape[0]
+        preds = [y2]  # preds[j]: prediction of y(n) from outputs measured up to n - j
+        for step in range(1, k + 1):
+            acc = x[start:].copy()
+            for lag in range(1, na + 1):
+                src = preds[max(step - lag, 0)]
+                acc -= dens[:, lag][None, :] * src[start - lag : n - lag]
+            cur = y2.copy()
+            cur[start:] = acc
+            preds.append(cur)
+        out = preds[k]
+        return out[:, 0] if (y_1d and self.n_outputs == 1) else out
+
+    def infer_input(
+        self, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
+    ) -> np.ndarray:
+        """The input that explains a measured output (SISO): ``u = (A y - k) / B``.
+
+        This is the paper's estimated torque command (Figs. 13-14).
+
+        Parameters
+        ----------
+        y : array_like, shape (T,)
+            Measured output.
+        y_init : array_like, shape (na,), optional
+            Outputs before ``y[0]`` (oldest first). Default: ``y[0]`` repeated (rest).
+        allow_unstable : bool
+            Compute even when ``B(z)`` has zeros outside the unit circle (the inverse
+            then diverges); default raises :class:`ModelError`.
+
+        Returns
+        -------
+        ndarray, shape (T - nk,)
+            ``u_hat[m]`` estimates ``u[m]`` for ``m = 0 .. T-nk-1`` (zero initial state of
+            the inverse filter).
+        """
+        self._siso("infer_input")
+        y2, _ = _as_2d(y, 1, "y")
+        yv = y2[:, 0]
+        s = self.structure
+        num = self.num[s.nk :]
+        if abs(num[0]) <= 1e-9 * max(np.max(np.abs(num)), 1e-300):
+            raise ModelError(
+                f"b0 is about 0 (numerator {num.round(9).tolist()}): the current input does "
+                "not reach the output after nk samples; increase nk by one and refit."
+            )
+        zeros = np.roots(num) if num.size > 1 else np.array([])
+        if zeros.size and np.max(np.abs(zeros)) >= 1.0 and not allow_unstable:
+            raise ModelError(
+                f"the inverse model is unstable: B(z) has zeros {np.round(zeros, 4).tolist()} "
+                "on or outside the unit circle (a non-minimum-phase model). Pass "
+                "allow_unstable=True to compute it anyway."
+            )
+        past = np.full(s.na, yv[0]) if y_init is None else np.asarray(y_init, float)[-s.na :]
+        y_ext = np.concatenate([past, yv])
+        w = signal.lfilter(self.den, [1.0], y_ext)[s.na :] - self.intercept[0]
+        u_hat = signal.lfilter([1.0], num, w)
+        return u_hat[s.nk :] if s.nk else u_hat
+
+    # ----------------------------------------------------------------- export
+    def _padded(self, output: int, input: int) -> tuple[np.ndarray, np.ndarray]:
+        """Numerator and denominator in descending powers of ``z`` (equal length)."""
+        num = self.numerators[output, input]
+        den = self.denominators[output]
+        n = max(num.size, den.size)
+        return np.pad(num, (0, n - num.size)), np.pad(den, (0, n - den.size))
+
+    def to_scipy(self, output: int = 0, input: int = 0) -> signal.dlti:
+        """Export one channel pair as :class:`scipy.signal.dlti` (``dt`` = sample time)."""
+        num, den = self._padded(output, input)
+        return signal.dlti(num, den, dt=self.dt)
+
+    def to_control(self) -> Any:
+        """Export as a python-control ``TransferFunction`` (MIMO when needed).
+
+        Needs the optional dependency ``control`` (``pip install clpc[control]``).
+        """
+        try:
+            import control
+        except ImportError:  # pragma: no cover - depends on the environment
+            raise ImportError(
+                "to_control() needs python-control: pip install 'clpc[control]'"
+            ) from None
+        nums = [
+            [list(self._padded(j, i)[0]) for i in range(self.n_inputs)]
+            for j in range(self.n_outputs)
+        ]
+        dens = [
+            [list(self._padded(j, i)[1]) for i in range(self.n_inputs)]
+            for j in range(self.n_outputs)
+        ]
+        if self.is_siso:
+            return control.TransferFunction(nums[0][0], dens[0][0], self.dt)
+        return control.TransferFunction(nums, dens, self.dt)
+
+    def __repr__(self) -> str:
+        s = self.structure
+        return (
+            f"LinearModel(na={s.na}, nb={s.nb}, nk={s.nk}, inputs={self.n_inputs}, "
+            f"outputs={self.n_outputs}, mode={self.mode!r}, dt={self.dt:g})"
+        )
