@@ -6,6 +6,7 @@ centered scatter matrix of lag vectors); CLPC runs it window by window as a fini
 machine and reports time-varying parameters and the degree of linearity of each cluster.
 """
 
+from .appraiser import CLPC
 from .arx import ARX, simulate_arx
 from .data import DataError, IOData, as_iodata
 from .lpc import LPC, lpc_solve
@@ -14,11 +15,14 @@ from .model import LinearModel, ModelError
 from .order import OrderSelection, select_order
 from .regressors import Structure
 from .solve import RobustRule
+from .trace import Convergence, Trace
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ARX",
+    "CLPC",
+    "Convergence",
     "LPC",
     "DataError",
     "IOData",
@@ -27,6 +31,7 @@ __all__ = [
     "OrderSelection",
     "RobustRule",
     "Structure",
+    "Trace",
     "as_iodata",
     "fit_percent",
     "kstep_fit",

@@ -59,7 +59,7 @@ class RobustRule:
     min_a0_weight: float = 0.1
     degeneracy_ratio: float = 2.0
     min_output_weight: float = 0.05
-    separation: float = 0.5
+    separation: float = 0.1
 
 
 @dataclass(frozen=True)
@@ -178,11 +178,13 @@ def solve_scatter(
     n_safe = np.maximum(n_rows, 1).astype(np.float64)
 
     transform = _whitening(scatter, n_rows, blocks, method, noise_cov)  # (k,p,p) or None
-    raw_vals, raw_vecs = _decompose(scatter, None, data)
+    vals, vecs = _decompose(scatter, transform, data)
     if transform is None:
-        vals, vecs = raw_vals, raw_vecs
-    else:
-        vals, vecs = _decompose(scatter, transform, data)
+        raw_vals = vals
+    elif data is not None:
+        raw_vals = np.linalg.svd(data, compute_uv=False)[:, ::-1] ** 2
+    else:  # only the paper's eigenvalues (for D) are needed from the raw matrix
+        raw_vals = np.linalg.eigvalsh(0.5 * (scatter + np.swapaxes(scatter, -1, -2)))
 
     # degenerate: nothing varies in the window, or a channel is constant
     diag = np.diagonal(scatter, axis1=-2, axis2=-1)

@@ -1,0 +1,681 @@
+"""CLPC: the paper's appraiser (section V), a finite-state machine over time windows.
+
+Semantics (``docs/clpc.md`` says the same):
+
+* Samples are numbered ``k = 0, 1, 2, ...`` (after decimation to ``sample_time``). The lag
+  vector ``z_k`` exists once ``k >= max_lag`` (``max_lag = N`` for the paper's structure).
+* ``window_size`` ``W`` is the number of lag vectors (rows of M, eq. 36) in one LPC.
+  The counter counts lag vectors; each time it reaches ``cluster_size`` ``C`` (the
+  paper's ``data_cluster_dimension``) the appraiser re-runs LPC on the window and resets the
+  counter; between updates the outputs hold their last values.
+* The window grows from the first lag vector until it holds ``W`` of them, then slides
+  (the rising D of the paper's Fig. 6). Update ``j`` (``j = 1, 2, ...``) closes after lag
+  vector ``m = C j`` and uses rows ``[max(0, m - W), m)``; its ``index`` is the newest
+  sample, ``k = max_lag + m - 1``.
+* An update with fewer than ``min_rows`` rows is flagged ``not_enough_data``; degenerate
+  windows (nothing varies, a constant channel) are flagged ``degenerate``; with ``gate=True``
+  an estimate the window does not determine (see :mod:`clpc.solve`) is not accepted. An
+  update that is not accepted holds the last accepted parameters; parameters are never NaN
+  (zeros, with ``has_model=False``, until a first estimate is accepted).
+* ``sample_time``: data sampled faster by an integer factor are low-pass filtered (causal
+  4th-order Butterworth at 0.8 of the new Nyquist frequency, filter state carried across
+  chunks) and every factor-th sample is kept (samples ``0, f, 2f, ...``).
+
+The state (the last window of samples, the counter, the last parameters, the filter state) is
+the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` serialise it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from .data import DataError, IOData, as_iodata
+from .lpc import fit_info, structure_blocks
+from .regressors import Structure, check_mode, default_mode, miso_regressor
+from .sliding import window_scatter
+from .solve import RobustRule, solve_scatter
+from .trace import Trace
+
+__all__ = ["CLPC"]
+
+_WINDOWS_PER_BATCH = 4096
+
+
+def _positive_int(value: Any, name: str, low: int = 1) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+        raise ValueError(f"{name} must be an int in the range [{low}, inf); got {value!r}.")
+    return int(value)
+
+
+class CLPC:
+    """The Cluster LPC appraiser: streaming ``step``/``push`` and a vectorised ``run``.
+
+    Parameters
+    ----------
+    parameters_size : int
+        Size of ``a`` and ``b`` (``N + 1``); the paper's Table 1 uses 3 (``N = 2``).
+    window_size : int
+        ``W``: lag vectors per LPC (Table 1: 201).
+    cluster_size : int
+        ``C``: lag vectors between updates (Table 1: 12). The paper's name
+        ``data_cluster_dimension`` is accepted too.
+    sample_time : float, optional
+        Sample time [s] the appraiser works at (Table 1: 0.01). Default: the data's.
+    data_cluster_dimension : int, optional
+        Alias of ``cluster_size``.
+    na, nb, nk : int, optional
+        Separate orders and input delay (override ``parameters_size``).
+    method, noise_ratio, noise_cov, rule
+        LPC options (see :class:`clpc.LPC`).
+    mimo : {"siso", "paired", "miso"}, optional
+        Multi-channel structure (default ``"siso"`` for 1x1 data, else ``"miso"``).
+    gate : bool
+        Accept an estimate only when the window determines it (default ``False``: every
+        computable estimate is accepted, as in the paper).
+    min_rows : int, optional
+        Fewest rows for a usable estimate (default ``2 p``).
+    data_sample_time : float, optional
+        Sample time of the data given to :meth:`step`/:meth:`push` [s] (default
+        ``sample_time``); :meth:`run` takes it from the record.
+    n_jobs : int
+        Threads for the batched solves (windows are independent).
+    chunk_samples : int
+        Samples processed at a time by :meth:`push` (bounds memory).
+    """
+
+    def __init__(
+        self,
+        parameters_size: int = 3,
+        window_size: int = 201,
+        cluster_size: int | None = None,
+        sample_time: float | None = None,
+        *,
+        data_cluster_dimension: int | None = None,
+        na: int | None = None,
+        nb: int | None = None,
+        nk: int = 0,
+        method: str = "robust",
+        mimo: str | None = None,
+        noise_ratio: float | None = None,
+        noise_cov: Any = None,
+        rule: RobustRule | None = None,
+        gate: bool = False,
+        min_rows: int | None = None,
+        data_sample_time: float | None = None,
+        n_jobs: int = 1,
+        chunk_samples: int = 65536,
+    ) -> None:
+        if cluster_size is not None and data_cluster_dimension is not None:
+            if cluster_size != data_cluster_dimension:
+                raise ValueError(
+                    "cluster_size and data_cluster_dimension are the same setting; got "
+                    f"{cluster_size} and {data_cluster_dimension}. Pass one of them."
+                )
+        cluster = cluster_size if cluster_size is not None else data_cluster_dimension
+        self.parameters_size = _positive_int(parameters_size, "parameters_size", 2)
+        self.window_size = _positive_int(window_size, "window_size", 2)
+        self.cluster_size = _positive_int(12 if cluster is None else cluster, "cluster_size")
+        order = self.parameters_size - 1
+        self.structure = Structure(
+            order if na is None else na, order if nb is None else nb, nk
+        )
+        if method not in ("robust", "paper"):
+            raise ValueError(f"method must be 'robust' or 'paper'; got {method!r}.")
+        self.method = method
+        self.mimo = mimo
+        self.noise_ratio = noise_ratio
+        self.noise_cov = None if noise_cov is None else np.asarray(noise_cov, dtype=float)
+        self.rule = rule or RobustRule()
+        self.gate = bool(gate)
+        self.min_rows = None if min_rows is None else _positive_int(min_rows, "min_rows", 2)
+        self.sample_time = None if sample_time is None else _positive(sample_time, "sample_time")
+        self.data_sample_time = (
+            None if data_sample_time is None else _positive(data_sample_time, "data_sample_time")
+        )
+        self.n_jobs = _positive_int(n_jobs, "n_jobs")
+        self.chunk_samples = _positive_int(chunk_samples, "chunk_samples", 1024)
+        self.reset()
+
+    # ================================================================= state
+    def reset(self) -> CLPC:
+        """Forget all data: empty window, counter 0, no parameters. Returns ``self``."""
+        self._n_in: int | None = None
+        self._n_out: int | None = None
+        self._names: tuple[tuple[str, ...], tuple[str, ...]] | None = None
+        self._buf = np.empty((0, 0))  # decimated samples [u | y], from sample _buf_start
+        self._buf_start = 0
+        self._n_seen = 0  # decimated samples seen
+        self._j_done = 0  # updates done
+        self._last_theta: np.ndarray | None = None
+        self._last_c: np.ndarray | None = None
+        self._has_model: np.ndarray | None = None
+        self._factor: int | None = None
+        self._dec_zi: np.ndarray | None = None
+        self._dec_phase = 0
+        self._pending: list[np.ndarray] = []
+        self._empty: Trace | None = None
+        return self
+
+    @property
+    def counter(self) -> int:
+        """Lag vectors since the last update (0 .. cluster_size - 1)."""
+        rows = max(self._n_seen - self.structure.max_lag, 0)
+        return rows - self._j_done * self.cluster_size
+
+    @property
+    def n_samples(self) -> int:
+        """Samples seen (after decimation)."""
+        return self._n_seen
+
+    @property
+    def theta(self) -> np.ndarray | None:
+        """Last output parameters (unit norm), shape (p,) or (n_outputs, p); None before data."""
+        if self._last_theta is None:
+            return None
+        out = self._last_theta.copy()
+        out.setflags(write=False)
+        return out[0] if out.shape[0] == 1 else out
+
+    @property
+    def window(self) -> np.ndarray:
+        """The current window's lag vectors (read-only), shape (rows, p) or (E, rows, p)."""
+        if self._n_in is None:
+            return np.empty((0, self.structure.n_params()))
+        self._flush_pending()
+        rows_total = max(self._n_seen - self.structure.max_lag, 0)
+        first = max(rows_total - self.window_size, 0)
+        rows = self._lag_rows(self._buf[first - self._buf_start :])
+        rows.setflags(write=False)
+        return rows[0] if rows.shape[0] == 1 else rows
+
+    # ================================================================= config helpers
+    def _mode(self) -> str:
+        assert self._n_in is not None and self._n_out is not None
+        mode = self.mimo or default_mode(self._n_in, self._n_out)
+        check_mode(mode, self._n_in, self._n_out)
+        return mode
+
+    def _n_blocks(self) -> int:
+        assert self._n_in is not None
+        return self._n_in if self._mode() == "miso" else 1
+
+    def _p(self) -> int:
+        return self.structure.n_params(self._n_blocks())
+
+    def _min_rows(self) -> int:
+        return self.min_rows if self.min_rows is not None else 2 * self._p()
+
+    def _noise(self) -> np.ndarray | None:
+        if self.noise_cov is not None:
+            return self.noise_cov
+        if self.noise_ratio is None:
+            return None
+        s = self.structure
+        ratio = float(self.noise_ratio)
+        if not np.isfinite(ratio) or ratio <= 0:
+            raise ValueError(f"noise_ratio must be > 0; got {self.noise_ratio!r}.")
+        return np.concatenate([np.ones(s.na + 1), np.full(self._n_blocks() * (s.nb + 1), ratio)])
+
+    def _init_channels(self, n_in: int, n_out: int, names: Any = None) -> None:
+        if self._n_in is None:
+            self._n_in, self._n_out = n_in, n_out
+            self._mode()  # validates
+            self._buf = np.empty((0, n_in + n_out))
+            p = self._p()
+            self._last_theta = np.zeros((n_out, p))
+            self._last_c = np.zeros(n_out)
+            self._has_model = np.zeros(n_out, dtype=bool)
+            if names is not None:
+                self._names = names
+        elif (n_in, n_out) != (self._n_in, self._n_out):
+            raise DataError(
+                f"the appraiser was fed {self._n_in} input(s) and {self._n_out} output(s); "
+                f"this chunk has {n_in} and {n_out}. Call reset() to start a new record."
+            )
+
+    # ================================================================= decimation
+    def _decimation_factor(self, data_dt: float | None) -> int:
+        target = self.sample_time
+        dt = data_dt if data_dt is not None else (self.data_sample_time or target)
+        if target is None or dt is None:
+            return 1
+        ratio = target / dt
+        factor = int(round(ratio))
+        if factor < 1 or abs(ratio - factor) > 1e-9 * max(ratio, 1.0):
+            raise DataError(
+                f"sample_time={target:g} s must be an integer multiple of the data's sample "
+                f"time {dt:g} s (ratio {ratio:g}); resample the data or choose sample_time "
+                "accordingly."
+            )
+        return factor
+
+    def _decimate(self, x: np.ndarray) -> np.ndarray:
+        f = self._factor or 1
+        if f == 1 or x.shape[0] == 0:
+            return x
+        sos = signal.butter(4, 0.8 / f, output="sos")
+        if self._dec_zi is None:  # start at rest at the first sample (no offset transient)
+            zi0 = signal.sosfilt_zi(sos)
+            self._dec_zi = zi0[:, :, None] * x[0][None, None, :]
+        filtered, self._dec_zi = signal.sosfilt(sos, x, axis=0, zi=self._dec_zi)
+        first = (-self._dec_phase) % f
+        kept = filtered[first::f]
+        self._dec_phase = (self._dec_phase + x.shape[0]) % f
+        return kept
+
+    # ================================================================= streaming API
+    def step(self, u_k: Any, y_k: Any) -> Trace:
+        """Feed one sample; returns the update it produced (a trace of 0 or 1 rows).
+
+        Parameters
+        ----------
+        u_k : float or array_like, shape (n_inputs,)
+        y_k : float or array_like, shape (n_outputs,)
+        """
+        u = np.atleast_1d(np.asarray(u_k, dtype=np.float64))
+        y = np.atleast_1d(np.asarray(y_k, dtype=np.float64))
+        rows_after = self._n_seen + 1 - self.structure.max_lag
+        if (
+            self._factor == 1
+            and self._n_in is not None
+            and u.shape == (self._n_in,)
+            and y.shape == (self._n_out,)
+            and (rows_after <= 0 or rows_after % self.cluster_size != 0)
+        ):  # fast path: no update completes; keep the sample aside (flushed by _consume)
+            sample = np.concatenate([u, y])
+            if not np.all(np.isfinite(sample)):
+                _check_finite(u[None], "u", self._n_seen)
+                _check_finite(y[None], "y", self._n_seen)
+            self._pending.append(sample)
+            self._n_seen += 1
+            return self._empty_trace()
+        return self.push(u[None, :], y[None, :])
+
+    def push(self, u: Any, y: Any) -> Trace:
+        """Feed a chunk of samples of any length.
+
+        Parameters
+        ----------
+        u : array_like, shape (n,) or (n, n_inputs)
+        y : array_like, shape (n,) or (n, n_outputs)
+
+        Returns
+        -------
+        Trace
+            The updates this chunk produced (possibly empty); the traces of consecutive
+            pushes concatenated equal :meth:`run` on the whole record.
+        """
+        u2 = _as_columns(u, "u")
+        y2 = _as_columns(y, "y")
+        if u2.shape[0] != y2.shape[0]:
+            raise DataError(
+                f"u and y must have the same length; got len(u)={u2.shape[0]}, "
+                f"len(y)={y2.shape[0]}."
+            )
+        _check_finite(u2, "u", self._n_seen)
+        _check_finite(y2, "y", self._n_seen)
+        self._init_channels(u2.shape[1], y2.shape[1])
+        if self._factor is None:
+            self._factor = self._decimation_factor(None)
+        parts = []
+        raw = np.hstack([u2, y2])
+        for lo in range(0, raw.shape[0], self.chunk_samples):
+            trace = self._consume(self._decimate(raw[lo : lo + self.chunk_samples]))
+            if len(trace):
+                parts.append(trace)
+        if not parts:
+            return self._empty_trace()
+        return parts[0] if len(parts) == 1 else Trace.concat(parts)
+
+    def run(self, u: Any, y: Any | None = None, dt: float | None = None) -> Trace:
+        """Reset, then process a whole record (vectorised over windows).
+
+        Parameters
+        ----------
+        u : IOData or array_like, shape (T,) or (T, n_inputs)
+        y : array_like, shape (T,) or (T, n_outputs), optional
+        dt : float, optional
+            Sample time of the record [s] (default: the record's, else ``sample_time``).
+
+        Returns
+        -------
+        Trace
+            One row per update.
+        """
+        data = as_iodata(u, y, dt)
+        given_dt = isinstance(u, IOData) or dt is not None
+        data_dt = data.dt if given_dt else None  # arrays without dt: already at sample_time
+        self.reset()
+        self._init_channels(data.n_inputs, data.n_outputs, (data.input_names, data.output_names))
+        self._factor = self._decimation_factor(data_dt)
+        return self.push(data.u, data.y)
+
+    # ================================================================= engine
+    def _lag_rows(self, buf: np.ndarray) -> np.ndarray:
+        """Lag rows of every equation from decimated samples ``buf``: (E, n, p)."""
+        assert self._n_in is not None and self._n_out is not None
+        u, y = buf[:, : self._n_in], buf[:, self._n_in :]
+        mode = self._mode()
+        if buf.shape[0] <= self.structure.max_lag:
+            return np.empty((self._n_out, 0, self._p()))
+        if mode == "miso":
+            mats = [miso_regressor(y[:, j], u, self.structure) for j in range(self._n_out)]
+        else:
+            mats = [
+                miso_regressor(y[:, j], u[:, j : j + 1], self.structure)
+                for j in range(self._n_out)
+            ]
+        return np.stack(mats)
+
+    def _consume(self, new: np.ndarray) -> Trace:
+        """Append decimated samples and compute the updates they complete."""
+        if new.shape[0] == 0:
+            return self._empty_trace()
+        self._flush_pending()
+        self._buf = np.vstack([self._buf, new]) if self._buf.size else new.copy()
+        self._n_seen += new.shape[0]
+        s, c, w = self.structure, self.cluster_size, self.window_size
+        rows_total = max(self._n_seen - s.max_lag, 0)
+        j_last = rows_total // c
+        trace = self._empty_trace()
+        if j_last > self._j_done:
+            rows = self._lag_rows(self._buf)  # absolute row index = _buf_start + i
+            parts = []
+            for j0 in range(self._j_done + 1, j_last + 1, _WINDOWS_PER_BATCH):
+                count = min(_WINDOWS_PER_BATCH, j_last + 1 - j0)
+                parts.append(self._updates(rows, j0, count))
+            trace = Trace.concat(parts)
+            self._j_done = j_last
+        # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
+        keep_row = max(0, c * (self._j_done + 1) - w - c)
+        drop = keep_row - self._buf_start
+        if drop > 0:
+            self._buf = self._buf[drop:].copy()
+            self._buf_start = keep_row
+        return trace
+
+    def _flush_pending(self) -> None:
+        """Move samples kept aside by the fast :meth:`step` path into the buffer."""
+        if self._pending:
+            block = np.vstack(self._pending)
+            self._buf = np.vstack([self._buf, block]) if self._buf.size else block
+            self._pending = []
+
+    def _updates(self, rows: np.ndarray, j0: int, count: int) -> Trace:
+        """Solve windows ``j0 .. j0 + count - 1`` (vectorised; threads when n_jobs > 1)."""
+        if self.n_jobs > 1 and count >= 64:
+            bounds = np.linspace(0, count, self.n_jobs + 1).astype(int)
+            with ThreadPoolExecutor(self.n_jobs) as pool:
+                results = list(
+                    pool.map(
+                        lambda ab: self._solve_windows(rows, j0 + ab[0], ab[1] - ab[0]),
+                        [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a],
+                    )
+                )
+            res = {k: np.concatenate([r[k] for r in results]) for k in results[0]}
+        else:
+            res = self._solve_windows(rows, j0, count)
+        return self._finish(res, j0, count, self.cluster_size)
+
+    def _solve_windows(self, rows: np.ndarray, j0: int, count: int) -> dict[str, np.ndarray]:
+        e = rows.shape[0]
+        scat, mean, n_rows = window_scatter(
+            rows, self._buf_start, j0, count, self.window_size, self.cluster_size
+        )
+        p = scat.shape[-1]
+        n_eq_rows = np.tile(n_rows, e)
+        res = solve_scatter(
+            scat.reshape(-1, p, p),
+            mean.reshape(-1, p),
+            n_eq_rows,
+            n_output_cols=self.structure.na + 1,
+            blocks=structure_blocks(self.structure, self._n_blocks()),
+            method=self.method,
+            noise_cov=self._noise(),
+            rule=self.rule,
+        )
+        info = fit_info(res, n_eq_rows, self.rule)
+        out = {"theta_estimate": res.theta, "n_rows_win": n_rows}
+        for key in ("eigenvalues", "lambda_min", "lambda_max", "D", "eig_ratio", "separation",
+                    "noise_variance", "J", "c", "n_null", "n_input_relations", "degenerate",
+                    "determined"):
+            out[key] = info[key]
+        # (E * count, ...) -> (count, E, ...)
+        for key, val in out.items():
+            if key != "n_rows_win":
+                out[key] = np.swapaxes(val.reshape(e, count, *val.shape[1:]), 0, 1)
+        return out
+
+    def _finish(self, res: dict[str, np.ndarray], j0: int, count: int, c: int) -> Trace:
+        """Accept/hold logic of the FSM output, monic forms and stability."""
+        assert self._last_theta is not None and self._last_c is not None
+        assert self._has_model is not None
+        s = self.structure
+        n_rows = res.pop("n_rows_win")
+        not_enough = n_rows < self._min_rows()
+        est = res["theta_estimate"]
+        a0_ok = est[:, :, 0] > 1e-9
+        accepted = ~not_enough[:, None] & ~res["degenerate"] & a0_ok
+        if self.gate:
+            accepted &= res["determined"]
+        # hold: the output is the last accepted estimate (carried across chunks)
+        idx = np.where(accepted, np.arange(count)[:, None], -1)
+        last = np.maximum.accumulate(idx, axis=0)  # (count, E)
+        have = last >= 0
+        e_idx = np.arange(est.shape[1])[None, :]
+        theta = np.where(have[..., None], est[np.maximum(last, 0), e_idx], self._last_theta[None])
+        c_out = np.where(have, res["c"][np.maximum(last, 0), e_idx], self._last_c[None])
+        has_model = have | self._has_model[None, :]
+        self._last_theta = theta[-1].copy()
+        self._last_c = c_out[-1].copy()
+        self._has_model = has_model[-1].copy()
+        den, num, stable = self._monic(theta, has_model)
+        j = np.arange(j0, j0 + count)
+        index = s.max_lag + c * j - 1
+        arrays = dict(res)
+        arrays.update(theta=theta, c=c_out, accepted=accepted, has_model=has_model,
+                      den=den, num=num, stable=stable)
+        dt = self.sample_time or 1.0
+        return self._trace(index, index * dt, n_rows, not_enough, arrays)
+
+    def _monic(
+        self, theta: np.ndarray, has_model: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s = self.structure
+        n, e, _ = theta.shape
+        a0 = np.where(has_model, theta[:, :, 0], 1.0)
+        den = theta[:, :, : s.na + 1] / a0[..., None]
+        den[~has_model] = np.eye(1, s.na + 1)[0]
+        b = theta[:, :, s.na + 1 :].reshape(n, e, -1, s.nb + 1)
+        num = np.zeros((n, e, self._n_in or 1, s.nk + s.nb + 1))
+        nb_blocks = b.shape[2]
+        if self._mode() == "miso":
+            num[:, :, :nb_blocks, s.nk :] = -b / a0[..., None, None]
+        else:
+            for j in range(e):
+                num[:, j, j, s.nk :] = -b[:, j, 0] / a0[:, j, None]
+        num[~has_model] = 0.0
+        comp = np.zeros((n, e, s.na, s.na))
+        comp[:, :, 0, :] = -den[:, :, 1:]
+        if s.na > 1:
+            comp[:, :, np.arange(1, s.na), np.arange(s.na - 1)] = 1.0
+        radius = np.abs(np.linalg.eigvals(comp)).max(axis=-1)
+        return den, num, has_model & (radius < 1.0)
+
+    def _trace(self, index, time, rows, not_enough, arrays) -> Trace:
+        names = self._names or (
+            tuple(f"u{i}" for i in range(self._n_in or 1)) if (self._n_in or 1) > 1 else ("u",),
+            tuple(f"y{i}" for i in range(self._n_out or 1)) if (self._n_out or 1) > 1 else ("y",),
+        )
+        return Trace(
+            index=np.asarray(index, dtype=np.int64),
+            time=np.asarray(time, dtype=np.float64),
+            rows=np.asarray(rows, dtype=np.int64),
+            not_enough_data=np.asarray(not_enough, dtype=bool),
+            arrays=arrays,
+            structure=self.structure,
+            n_inputs=self._n_in or 1,
+            mode=self._mode() if self._n_in is not None else "siso",
+            sample_time=self.sample_time or 1.0,
+            input_names=names[0],
+            output_names=names[1],
+        )
+
+    def _empty_trace(self) -> Trace:
+        if self._empty is not None:
+            return self._empty
+        e = self._n_out or 1
+        p = self._p() if self._n_in is not None else self.structure.n_params()
+        s = self.structure
+        shapes = {
+            "theta": (p,), "theta_estimate": (p,), "den": (s.na + 1,),
+            "num": (self._n_in or 1, s.nk + s.nb + 1), "eigenvalues": (p,),
+        }
+        ints = ("n_null", "n_input_relations")
+        bools = ("degenerate", "determined", "accepted", "has_model", "stable")
+        arrays = {}
+        for key in ("theta", "theta_estimate", "den", "num", "eigenvalues", "lambda_min",
+                    "lambda_max", "D", "eig_ratio", "separation", "noise_variance", "J", "c",
+                    *ints, *bools):
+            dtype = np.int64 if key in ints else (bool if key in bools else np.float64)
+            arrays[key] = np.zeros((0, e, *shapes.get(key, ())), dtype=dtype)
+        z = np.zeros(0)
+        empty = self._trace(z, z, z, z.astype(bool), arrays)
+        if self._n_in is not None:
+            self._empty = empty
+        return empty
+
+    # ================================================================= persistence
+    def config(self) -> dict[str, Any]:
+        """Constructor arguments (JSON-safe)."""
+        return {
+            "parameters_size": self.parameters_size,
+            "window_size": self.window_size,
+            "cluster_size": self.cluster_size,
+            "sample_time": self.sample_time,
+            "na": self.structure.na,
+            "nb": self.structure.nb,
+            "nk": self.structure.nk,
+            "method": self.method,
+            "mimo": self.mimo,
+            "noise_ratio": self.noise_ratio,
+            "noise_cov": None if self.noise_cov is None else self.noise_cov.tolist(),
+            "rule": asdict(self.rule),
+            "gate": self.gate,
+            "min_rows": self.min_rows,
+            "data_sample_time": self.data_sample_time,
+            "n_jobs": self.n_jobs,
+            "chunk_samples": self.chunk_samples,
+        }
+
+    def state_dict(self) -> dict[str, Any]:
+        """The FSM state and configuration as a JSON-safe dict (floats round-trip exactly)."""
+
+        def arr(x: np.ndarray | None) -> Any:
+            return None if x is None else {"shape": list(x.shape), "data": x.ravel().tolist()}
+
+        self._flush_pending()
+        return {
+            "format": "clpc-appraiser-state",
+            "version": 1,
+            "config": self.config(),
+            "n_in": self._n_in,
+            "n_out": self._n_out,
+            "names": None if self._names is None else [list(n) for n in self._names],
+            "buf": arr(self._buf),
+            "buf_start": self._buf_start,
+            "n_seen": self._n_seen,
+            "j_done": self._j_done,
+            "last_theta": arr(self._last_theta),
+            "last_c": arr(self._last_c),
+            "has_model": None if self._has_model is None else self._has_model.tolist(),
+            "factor": self._factor,
+            "dec_zi": arr(self._dec_zi),
+            "dec_phase": self._dec_phase,
+        }
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> CLPC:
+        """Rebuild an appraiser from :meth:`state_dict` output; it continues identically."""
+        if state.get("format") != "clpc-appraiser-state" or state.get("version") != 1:
+            raise ValueError("not a clpc appraiser state (format/version mismatch).")
+        cfg = dict(state["config"])
+        cfg.pop("parameters_size")
+        rule = RobustRule(**cfg.pop("rule"))
+        obj = cls(state["config"]["parameters_size"], rule=rule, **cfg)
+
+        def arr(x: Any) -> np.ndarray | None:
+            return None if x is None else np.asarray(x["data"], float).reshape(x["shape"])
+
+        obj._n_in, obj._n_out = state["n_in"], state["n_out"]
+        obj._names = None if state["names"] is None else tuple(tuple(n) for n in state["names"])
+        obj._buf = arr(state["buf"])
+        obj._buf_start = int(state["buf_start"])
+        obj._n_seen = int(state["n_seen"])
+        obj._j_done = int(state["j_done"])
+        obj._last_theta = arr(state["last_theta"])
+        obj._last_c = arr(state["last_c"])
+        hm = state["has_model"]
+        obj._has_model = None if hm is None else np.asarray(hm, dtype=bool)
+        obj._factor = state["factor"]
+        obj._dec_zi = arr(state["dec_zi"])
+        obj._dec_phase = int(state["dec_phase"])
+        return obj
+
+    def save(self, path: str) -> None:
+        """Write :meth:`state_dict` as JSON to ``path``."""
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(self.state_dict(), fh)
+
+    @classmethod
+    def load(cls, path: str) -> CLPC:
+        """Read an appraiser saved with :meth:`save`."""
+        with open(path, encoding="utf-8") as fh:
+            return cls.from_state_dict(json.load(fh))
+
+    def __repr__(self) -> str:
+        return (
+            f"CLPC(parameters_size={self.parameters_size}, window_size={self.window_size}, "
+            f"cluster_size={self.cluster_size}, sample_time={self.sample_time}, "
+            f"method={self.method!r}, samples_seen={self._n_seen}, updates={self._j_done})"
+        )
+
+
+def _positive(value: Any, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a positive number of seconds; got {value!r}.") from None
+    if not np.isfinite(v) or v <= 0:
+        raise ValueError(f"{name} must be a positive number of seconds; got {value!r}.")
+    return v
+
+
+def _as_columns(x: Any, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DataError(f"{name} must hold numbers; got {type(x).__name__}.") from None
+    if arr.ndim == 0:
+        arr = arr[None, None]
+    elif arr.ndim == 1:
+        arr = arr[:, None]
+    elif arr.ndim != 2:
+        raise DataError(f"{name} must be 1-D or 2-D; got shape {arr.shape}.")
+    return arr
+
+
+def _check_finite(arr: np.ndarray, name: str, offset: int) -> None:
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise DataError(
+            f"{name} channel {col} is not finite at sample {offset + row} (counting from the "
+            "first sample fed); remove or interpolate missing samples."
+        )

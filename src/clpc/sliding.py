@@ -1,0 +1,120 @@
+r"""Exact sliding-window scatter matrices, vectorised over windows.
+
+CLPC (section V) updates every ``C`` lag vectors on the last ``W`` of them. The update that
+closes after lag vector ``m = C j`` uses rows ``[max(0, m - W), m)``. Write ``W = q C + r``
+and cut the lag rows into blocks ``[l C, (l + 1) C)``; a window then is::
+
+    tail of block j-q-1 (its last r rows)  +  blocks j-q, ..., j-1 (full)
+    \________ r rows ____________________/    \_______ q C rows ________/
+
+(while the window is still growing, blocks 0..j-1 only). Each piece is summarised by its
+count, mean and centered scatter (two-pass, exact), and pieces are merged with the parallel
+formula of Chan, Golub and LeVeque::
+
+    n = sum n_b,   mean = sum n_b mean_b / n,
+    A = sum A_b + sum n_b (mean_b - mean)(mean_b - mean)^T
+
+Every term is centered, so large offsets (positions around 1e4 rad) and long records (the
+statistics are never accumulated over the record) lose no digits. Cost per window is
+``O((q + 1) p^2)`` plus ``O(C p^2)`` per block, instead of ``O(W p^2)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["block_stats", "window_scatter"]
+
+
+def block_stats(rows: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and centered scatter of consecutive blocks of rows.
+
+    Parameters
+    ----------
+    rows : ndarray, shape (E, n_blocks * size, p)
+        Lag rows of ``E`` equations.
+    size : int
+        Rows per block (> 0).
+
+    Returns
+    -------
+    mean : ndarray, shape (E, n_blocks, p)
+    scatter : ndarray, shape (E, n_blocks, p, p)
+    """
+    e, n, p = rows.shape
+    blocks = rows.reshape(e, n // size, size, p)
+    mean = blocks.mean(axis=2)
+    centered = blocks - mean[:, :, None, :]
+    scatter = np.swapaxes(centered, -1, -2) @ centered
+    return mean, scatter
+
+
+def window_scatter(
+    rows: np.ndarray, first_row: int, first_window: int, n_windows: int, window: int, cluster: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Scatter matrices of consecutive CLPC windows.
+
+    Parameters
+    ----------
+    rows : ndarray, shape (E, n, p)
+        Lag rows with absolute row indices ``first_row .. first_row + n - 1``; they must
+        cover every requested window ``[max(0, C j - W), C j)``.
+    first_row : int
+        Absolute index of ``rows[:, 0]``.
+    first_window, n_windows : int
+        The windows closing after rows ``C j`` for ``j = first_window .. first_window +
+        n_windows - 1`` (``first_window >= 1``).
+    window, cluster : int
+        ``W`` and ``C``.
+
+    Returns
+    -------
+    scatter : ndarray, shape (E, n_windows, p, p)
+    mean : ndarray, shape (E, n_windows, p)
+    n_rows : ndarray of int, shape (n_windows,)
+    """
+    e, n, p = rows.shape
+    q, r = divmod(window, cluster)
+    j0, j1 = first_window, first_window + n_windows
+    lo_block = max(j0 - q - (1 if r else 0), 0)
+    start = lo_block * cluster - first_row
+    if start < 0 or (j1 - 1) * cluster - first_row > n:
+        raise ValueError("rows do not cover the requested windows")  # internal misuse
+    span = rows[:, start : start + (j1 - 1 - lo_block) * cluster]
+    f_mean, f_scat = block_stats(span, cluster)  # (E, n_blocks, p), (E, n_blocks, p, p)
+    pieces = [(-q + o, cluster, f_mean, f_scat) for o in range(q)]
+    if r:
+        tails = span.reshape(e, -1, cluster, p)[:, :, cluster - r :, :]
+        t_mean, t_scat = block_stats(tails.reshape(e, -1, p), r)
+        pieces.append((-q - 1, r, t_mean, t_scat))
+    # windows whose pieces all exist (the window has stopped growing) ...
+    j_full = max(j0, q + (1 if r else 0))
+    out_s = np.empty((e, n_windows, p, p))
+    out_m = np.empty((e, n_windows, p))
+    out_n = np.empty(n_windows, dtype=np.int64)
+    if j_full < j1:
+        sel = slice(j_full - j0, n_windows)
+        out_s[:, sel], out_m[:, sel], out_n[sel] = _merge_slices(
+            pieces, j_full - lo_block, j1 - j_full
+        )
+    # ... and the first ones, still growing (at most q + 1 of them): pieces may not exist
+    for jj in range(j0, min(j_full, j1)):
+        use = [pc for pc in pieces if jj + pc[0] >= 0]
+        s_, m_, n_ = _merge_slices(use, jj - lo_block, 1)
+        out_s[:, jj - j0], out_m[:, jj - j0], out_n[jj - j0] = s_[:, 0], m_[:, 0], n_[0]
+    return out_s, out_m, out_n
+
+
+def _merge_slices(
+    pieces: list[tuple[int, int, np.ndarray, np.ndarray]], first: int, count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge pieces for ``count`` consecutive windows; piece offset ``o`` of window ``w``
+    is block ``first + w + o`` (parallel formula of the module docstring)."""
+    n_rows = float(sum(size for _, size, _, _ in pieces))
+    total = sum(size * means[:, first + o : first + o + count] for o, size, means, _ in pieces)
+    mean = total / n_rows
+    scatter = sum(scats[:, first + o : first + o + count] for o, _, _, scats in pieces)
+    for o, size, means, _ in pieces:
+        dev = means[:, first + o : first + o + count] - mean
+        scatter = scatter + size * (dev[..., :, None] * dev[..., None, :])
+    return scatter, mean, np.full(count, int(n_rows), dtype=np.int64)

@@ -1,0 +1,279 @@
+"""The output of the appraiser: one row per cluster update, plus the convergence verdict."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import numpy as np
+
+from .model import LinearModel
+from .regressors import Structure
+
+__all__ = ["Convergence", "Trace"]
+
+# per-update arrays; axis 1 (when present) is the equation (output) axis
+_PER_EQUATION = (
+    "theta",
+    "theta_estimate",
+    "den",
+    "num",
+    "eigenvalues",
+    "lambda_min",
+    "lambda_max",
+    "D",
+    "eig_ratio",
+    "separation",
+    "noise_variance",
+    "J",
+    "c",
+    "n_null",
+    "n_input_relations",
+    "degenerate",
+    "determined",
+    "accepted",
+    "has_model",
+    "stable",
+)
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """When the appraiser's outputs became quasi-constant.
+
+    Attributes
+    ----------
+    converged : bool
+        Whether ``consecutive`` accepted updates in a row changed less than the tolerances.
+    update : int
+        Row of the trace where the quasi-constant phase starts (-1 if never).
+    index : int
+        Sample index of that update (-1 if never).
+    time : float
+        Its time [s] (nan if never).
+    theta_tol, D_tol : float
+        Tolerances used: ``||theta_j - theta_{j-1}||`` (unit vectors) and
+        ``|D_j - D_{j-1}| / D_j``.
+    consecutive : int
+    theta_variation : float
+        After convergence: largest ``||theta_j - theta_ss||`` over accepted updates.
+    D_variation : float
+        After convergence: largest ``|D_j - mean D| / mean D``.
+    """
+
+    converged: bool
+    update: int
+    index: int
+    time: float
+    theta_tol: float
+    D_tol: float
+    consecutive: int
+    theta_variation: float
+    D_variation: float
+
+
+@dataclass(frozen=True, eq=False)
+class Trace:
+    """Per-update record of a CLPC run (one row per cluster update).
+
+    Arrays of every equation carry an equation axis 1; the properties of the same name
+    drop it for single-output models (``theta`` is then (n_updates, p)).
+
+    Attributes
+    ----------
+    index : ndarray of int, shape (n,)
+        Sample index ``k`` of the newest sample in the window (after decimation).
+    time : ndarray, shape (n,)
+        ``index * sample_time`` [s].
+    rows : ndarray of int, shape (n,)
+        Lag vectors in the window.
+    not_enough_data : ndarray of bool, shape (n,)
+        Fewer rows than ``min_rows``: the estimate is not used.
+    arrays : dict
+        Per-equation arrays (see :data:`_PER_EQUATION`): ``theta`` (held output, unit norm,
+        paper convention), ``theta_estimate`` (this window's solution), ``den``/``num``
+        (monic, ascending powers of ``z^-1``, of the held ``theta``), eigenvalues,
+        ``lambda_min``, ``lambda_max``, ``D``, ``eig_ratio``, ``separation``,
+        ``noise_variance``, ``J``, ``c``, ``n_null``, ``n_input_relations`` and flags
+        ``degenerate``, ``determined``, ``accepted``, ``has_model``, ``stable``.
+    """
+
+    index: np.ndarray
+    time: np.ndarray
+    rows: np.ndarray
+    not_enough_data: np.ndarray
+    arrays: dict[str, np.ndarray]
+    structure: Structure
+    n_inputs: int
+    mode: str
+    sample_time: float
+    input_names: tuple[str, ...] = ("u",)
+    output_names: tuple[str, ...] = ("y",)
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return int(self.index.shape[0])
+
+    @property
+    def n_equations(self) -> int:
+        """Number of equations (outputs)."""
+        return int(self.arrays["theta"].shape[1])
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        arrays = self.__dict__.get("arrays")
+        if arrays is not None and name in arrays:
+            value = arrays[name]
+            return value[:, 0] if value.shape[1] == 1 else value
+        raise AttributeError(name)
+
+    # ----------------------------------------------------------------- building
+    @classmethod
+    def concat(cls, traces: list[Trace], like: Trace | None = None) -> Trace:
+        """Concatenate traces of the same appraiser in time order."""
+        traces = [t for t in traces if t is not None]
+        if not traces:
+            raise ValueError("nothing to concatenate")
+        first = traces[0] if like is None else like
+        plain = ("index", "time", "rows", "not_enough_data")
+        kw = {f: np.concatenate([getattr(t, f) for t in traces]) for f in plain}
+        arrays = {k: np.concatenate([t.arrays[k] for t in traces]) for k in first.arrays}
+        rest = {
+            f.name: getattr(first, f.name)
+            for f in fields(cls)
+            if f.name not in plain and f.name != "arrays"
+        }
+        return cls(**kw, arrays=arrays, **rest)
+
+    # ----------------------------------------------------------------- views
+    def labels(self) -> list[str]:
+        """Names of the entries of ``theta``: ``a0 .. a_na, b0 .. b_nb`` per input block."""
+        s = self.structure
+        names = [f"a{i}" for i in range(s.na + 1)]
+        n_blocks = self.n_inputs if self.mode == "miso" else 1
+        for blk in range(n_blocks):
+            suffix = f"_{self.input_names[blk]}" if n_blocks > 1 else ""
+            names += [f"b{i}{suffix}" for i in range(s.nb + 1)]
+        return names
+
+    def to_frame(self) -> Any:
+        """The trace as a pandas DataFrame (one row per update; needs pandas)."""
+        import pandas as pd
+
+        cols: dict[str, Any] = {
+            "index": self.index,
+            "time": self.time,
+            "rows": self.rows,
+            "not_enough_data": self.not_enough_data,
+        }
+        labels = self.labels()
+        for e in range(self.n_equations):
+            pre = f"{self.output_names[e]}:" if self.n_equations > 1 else ""
+            for i, lab in enumerate(labels):
+                cols[pre + lab] = self.arrays["theta"][:, e, i]
+            for key in ("lambda_min", "lambda_max", "D", "eig_ratio", "separation",
+                        "noise_variance", "J", "c", "n_null", "n_input_relations",
+                        "degenerate", "determined", "accepted", "has_model", "stable"):
+                cols[pre + key] = self.arrays[key][:, e]
+        return pd.DataFrame(cols)
+
+    def held(self, n_samples: int) -> np.ndarray:
+        """Held output parameters at every sample ``k = 0 .. n_samples - 1``.
+
+        Returns
+        -------
+        ndarray, shape (n_samples, n_equations, p)
+            Zeros before the first update (no model yet).
+        """
+        k = np.arange(n_samples)
+        last = np.searchsorted(self.index, k, side="right") - 1
+        theta = self.arrays["theta"]
+        out = np.zeros((n_samples, *theta.shape[1:]))
+        ok = last >= 0
+        out[ok] = theta[last[ok]]
+        return out
+
+    # ----------------------------------------------------------------- verdict
+    def convergence(
+        self, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
+    ) -> Convergence:
+        """First update after which ``theta`` and ``D`` stay quasi-constant.
+
+        An update is quasi-constant when every equation's accepted ``theta`` moved by less
+        than ``theta_tol`` (Euclidean, unit vectors) and ``D`` by less than ``D_tol``
+        (relative) since the previous update; convergence needs ``consecutive`` such
+        updates in a row.
+        """
+        acc = self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1)
+        theta = self.arrays["theta"]
+        d = self.arrays["D"]
+        n = len(self)
+        quiet = np.zeros(n, dtype=bool)
+        if n > 1:
+            dtheta = np.linalg.norm(theta[1:] - theta[:-1], axis=2).max(axis=1)
+            scale = np.maximum(np.abs(d[1:]), np.finfo(float).tiny)
+            dd = (np.abs(d[1:] - d[:-1]) / scale).max(axis=1)
+            quiet[1:] = acc[1:] & acc[:-1] & (dtheta < theta_tol) & (dd < D_tol)
+        run = np.convolve(quiet.astype(int), np.ones(consecutive, dtype=int), "valid")
+        hits = np.flatnonzero(run == consecutive) if run.size else np.array([], int)
+        if hits.size == 0:
+            return Convergence(False, -1, -1, float("nan"), theta_tol, D_tol, consecutive,
+                               float("nan"), float("nan"))
+        start = int(hits[0])
+        after = acc & (np.arange(n) >= start)
+        ss = _mean_theta(theta[after])
+        th_var = float(np.linalg.norm(theta[after] - ss[None], axis=2).max())
+        d_mean = d[after].mean(axis=0)
+        d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
+        return Convergence(True, start, int(self.index[start]), float(self.time[start]),
+                           theta_tol, D_tol, consecutive, th_var, d_var)
+
+    def steady_state_model(
+        self, convergence: Convergence | None = None, *, allow_unconverged: bool = False
+    ) -> LinearModel:
+        """The identified black box: the mean accepted ``theta`` of the quasi-constant phase.
+
+        Parameters
+        ----------
+        convergence : Convergence, optional
+            Default: :meth:`convergence` with its default tolerances.
+        allow_unconverged : bool
+            If the trace never converged, use the last accepted update instead of raising.
+
+        Returns
+        -------
+        LinearModel
+            With ``info["convergence"]``.
+        """
+        conv = convergence or self.convergence()
+        acc = self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1)
+        if conv.converged:
+            sel = acc & (np.arange(len(self)) >= conv.update)
+        elif allow_unconverged and acc.any():
+            sel = np.zeros(len(self), dtype=bool)
+            sel[np.flatnonzero(acc)[-1]] = True
+        else:
+            raise ValueError(
+                "the trace never became quasi-constant (no steady state): "
+                f"{int(acc.sum())} of {len(self)} updates were accepted. Use a longer record, "
+                "a richer input, larger tolerances, or allow_unconverged=True."
+            )
+        theta = _mean_theta(self.arrays["theta"][sel])
+        c = self.arrays["c"][sel].mean(axis=0)
+        return LinearModel(
+            theta=theta,
+            structure=self.structure,
+            n_inputs=self.n_inputs,
+            mode=self.mode,
+            c=c,
+            dt=self.sample_time,
+            input_names=self.input_names,
+            output_names=self.output_names,
+            info={"convergence": conv, "method": "clpc-steady-state",
+                  "updates_used": int(sel.sum())},
+        )
+
+
+def _mean_theta(theta: np.ndarray) -> np.ndarray:
+    """Mean of unit vectors (a0 > 0 already), renormalised: shape (E, p)."""
+    mean = theta.mean(axis=0)
+    return mean / np.linalg.norm(mean, axis=1, keepdims=True)

@@ -1,0 +1,350 @@
+"""The CLPC appraiser: semantics, streaming == batch, persistence, exactness, tracking."""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import signal
+
+import clpc
+from clpc import CLPC, DataError, Trace
+
+DEN = np.array([1.0, -1.5, 0.7])
+NUM = np.array([0.2, 0.5, 0.1])
+
+
+def record(n: int, seed: int = 0, noise: float = 0.0, offset: float = 0.0):
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = clpc.simulate_arx(DEN, NUM, u)
+    if noise:
+        y = y + noise * rng.standard_normal(n)
+    return u + offset, y + offset
+
+
+def exact_window(u, y, end_row, window, order=2):
+    """Independent reference: lag matrix of the window, centered, SVD."""
+    rows = np.array(
+        [
+            np.concatenate([y[k - np.arange(order + 1)], u[k - np.arange(order + 1)]])
+            for k in range(order + max(0, end_row - window), order + end_row)
+        ]
+    )
+    centered = rows - rows.mean(axis=0)
+    _, s, vt = np.linalg.svd(centered, full_matrices=False)
+    return centered.T @ centered, s[::-1] ** 2, vt[::-1]
+
+
+# ---------------------------------------------------------------- semantics
+@pytest.mark.parametrize(("window", "cluster"), [(201, 12), (30, 7), (24, 12), (10, 1)])
+def test_updates_every_cluster_growing_then_sliding(window, cluster):
+    u, y = record(600)
+    trace = CLPC(3, window, cluster).run(u, y)
+    max_lag = 2
+    j = np.arange(1, (600 - max_lag) // cluster + 1)
+    assert len(trace) == j.size
+    np.testing.assert_array_equal(trace.index, max_lag + cluster * j - 1)
+    np.testing.assert_array_equal(trace.rows, np.minimum(cluster * j, window))
+    # the window grows first, then slides at exactly window_size rows
+    assert np.all(np.diff(trace.rows[trace.rows < window]) == cluster)
+
+
+def test_paper_names_and_time():
+    u, y = record(500)
+    a = CLPC(parameters_size=3, window_size=201, data_cluster_dimension=12, sample_time=0.01)
+    trace = a.run(u, y)
+    assert a.cluster_size == 12
+    np.testing.assert_allclose(trace.time, trace.index * 0.01)
+    with pytest.raises(ValueError, match="same setting"):
+        CLPC(3, 201, cluster_size=12, data_cluster_dimension=10)
+
+
+def test_outputs_hold_between_updates():
+    u, y = record(400, noise=0.05)
+    trace = CLPC(3, 50, 12).run(u, y)
+    held = trace.held(400)
+    for k in (0, 13, 14, 25, 26, 100, 399):
+        last = np.flatnonzero(trace.index <= k)
+        expect = np.zeros(6) if last.size == 0 else trace.theta[last[-1]]
+        np.testing.assert_array_equal(held[k, 0], expect)
+
+
+def test_not_enough_data_is_flagged_and_not_used():
+    u, y = record(300)
+    trace = CLPC(3, 201, 4).run(u, y)
+    p = 6
+    assert np.all(trace.not_enough_data == (trace.rows < 2 * p))
+    first_ok = np.flatnonzero(~trace.not_enough_data)[0]
+    assert not trace.has_model[:first_ok].any()
+    assert np.all(trace.theta[:first_ok] == 0)
+    assert trace.has_model[first_ok]
+    trace2 = CLPC(3, 201, 4, min_rows=40).run(u, y)
+    assert np.all(trace2.not_enough_data == (trace2.rows < 40))
+
+
+def test_noise_free_recovery_and_steady_state():
+    u, y = record(3000)
+    trace = CLPC(3, 201, 12, sample_time=0.01).run(u, y)
+    ok = trace.accepted
+    np.testing.assert_allclose(trace.den[ok], np.broadcast_to(DEN, (ok.sum(), 3)), atol=1e-9)
+    np.testing.assert_allclose(trace.num[ok][:, 0], np.broadcast_to(NUM, (ok.sum(), 3)), atol=1e-9)
+    conv = trace.convergence()
+    # D grows with the window (Fig. 6) and is quasi-constant once the window is full
+    assert conv.converged and conv.update <= 201 // 12 + 1
+    model = trace.steady_state_model()
+    np.testing.assert_allclose(model.den, DEN, atol=1e-9)
+    np.testing.assert_allclose(model.num, NUM, atol=1e-9)
+    assert model.dt == 0.01 and model.is_stable
+
+
+def test_unconverged_steady_state_raises():
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(800)
+    y = rng.standard_normal(800)  # no relation at all: parameters wander
+    trace = CLPC(3, 30, 6).run(u, y)
+    conv = trace.convergence(theta_tol=1e-6, D_tol=1e-6)
+    assert not conv.converged
+    with pytest.raises(ValueError, match="never became quasi-constant"):
+        trace.steady_state_model(conv)
+    model = trace.steady_state_model(conv, allow_unconverged=True)
+    np.testing.assert_allclose(model.theta[0], trace.theta[np.flatnonzero(trace.accepted)[-1]])
+
+
+# ---------------------------------------------------------------- streaming == batch
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.integers(min_value=1, max_value=300), min_size=1, max_size=40))
+def test_push_any_chunking_equals_run(chunks):
+    u, y = record(2500, seed=1, noise=0.01)
+    batch = CLPC(3, 201, 12).run(u, y)
+    a = CLPC(3, 201, 12)
+    parts, i = [], 0
+    sizes = itertools.cycle(chunks)
+    while i < u.size:
+        n = next(sizes)
+        parts.append(a.push(u[i : i + n], y[i : i + n]))
+        i += n
+    streamed = Trace.concat(parts)
+    assert len(streamed) == len(batch)
+    for key in ("theta", "D", "eigenvalues", "c", "den", "num", "accepted"):
+        np.testing.assert_allclose(
+            np.asarray(streamed.arrays[key], float), np.asarray(batch.arrays[key], float),
+            rtol=1e-12, atol=1e-12 * np.abs(np.asarray(batch.arrays[key], float)).max(),
+        )
+    np.testing.assert_array_equal(streamed.index, batch.index)
+
+
+def test_step_equals_run_and_exposes_state():
+    u, y = record(700, seed=2, noise=0.01)
+    batch = CLPC(3, 60, 12).run(u, y)
+    a = CLPC(3, 60, 12)
+    parts = [a.step(u[k], y[k]) for k in range(700)]
+    streamed = Trace.concat(parts)
+    np.testing.assert_allclose(streamed.theta, batch.theta, rtol=0, atol=1e-12)
+    assert a.counter == (700 - 2) % 12
+    assert a.window.shape == (60, 6)
+    np.testing.assert_array_equal(a.theta, batch.theta[-1])
+    with pytest.raises(ValueError):
+        a.window[0, 0] = 1.0  # read-only view
+
+
+def test_save_restore_mid_record_continues_identically(tmp_path):
+    u, y = record(1500, seed=4, noise=0.02)
+    full = CLPC(3, 101, 12, sample_time=0.01).run(u, y)
+    a = CLPC(3, 101, 12, sample_time=0.01)
+    first = a.push(u[:777], y[:777])
+    state = json.loads(json.dumps(a.state_dict()))
+    b = CLPC.from_state_dict(state)
+    second = b.push(u[777:], y[777:])
+    both = Trace.concat([first, second])
+    np.testing.assert_array_equal(both.theta, full.theta)
+    np.testing.assert_array_equal(both.D, full.D)
+    a.save(str(tmp_path / "state.json"))
+    c = CLPC.load(str(tmp_path / "state.json"))
+    np.testing.assert_array_equal(c.push(u[777:], y[777:]).theta, second.theta)
+    with pytest.raises(ValueError, match="not a clpc appraiser state"):
+        CLPC.from_state_dict({"format": "other"})
+
+
+# ---------------------------------------------------------------- exactness
+def test_fast_path_equals_exact_recomputation_with_offsets():
+    u, y = record(4000, seed=5, noise=0.05, offset=1e4)
+    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    for t in range(0, len(trace), 7):
+        end_row = (t + 1) * 12
+        scatter, vals, vecs = exact_window(u, y, end_row, 201)
+        np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
+        np.testing.assert_allclose(trace.D[t], vals[-1] - vals[0], rtol=1e-9)
+        if vals[0] < 0.1 * vals[1]:
+            ref = vecs[0] * np.sign(vecs[0][0])
+            np.testing.assert_allclose(trace.theta_estimate[t], ref, atol=1e-9)
+
+
+def test_no_drift_over_a_million_samples():
+    rng = np.random.default_rng(6)
+    n = 1_000_000
+    u = rng.standard_normal(n) + 1e4
+    y = clpc.simulate_arx(DEN, NUM, u - 1e4) + 0.05 * rng.standard_normal(n) + 1e4
+    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    for t in (len(trace) - 1, len(trace) // 2, len(trace) - 1000):
+        scatter, vals, vecs = exact_window(u, y, (t + 1) * 12, 201)
+        np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
+        ref = vecs[0] * np.sign(vecs[0][0])
+        assert vals[0] < 0.1 * vals[1]
+        np.testing.assert_allclose(trace.theta_estimate[t], ref, atol=1e-9)
+
+
+# ---------------------------------------------------------------- behaviour
+def test_tracks_a_parameter_jump_within_one_window():
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(4000)
+    den2, num2 = np.array([1.0, -0.9, 0.2]), np.array([1.0, -0.3, 0.4])
+    y1 = clpc.simulate_arx(DEN, NUM, u[:2000])
+    # continue with the new system from the state of the old one: simulate the new
+    # difference equation directly
+    y = np.concatenate([y1, np.zeros(2000)])
+    for n in range(2000, 4000):
+        y[n] = -den2[1] * y[n - 1] - den2[2] * y[n - 2] + num2 @ u[n - np.arange(3)]
+    trace = CLPC(3, 201, 12).run(u, y)
+    after = trace.index >= 2000 + 201 + 12
+    np.testing.assert_allclose(trace.den[after], np.broadcast_to(den2, (after.sum(), 3)), atol=1e-8)
+    before = (trace.index < 2000) & trace.accepted
+    np.testing.assert_allclose(trace.den[before], np.broadcast_to(DEN, (before.sum(), 3)), atol=1e-8)
+
+
+@pytest.mark.parametrize("kind", ["constant", "zeros", "repeated"])
+def test_degenerate_windows_are_flagged_not_crashed(kind):
+    rng = np.random.default_rng(8)
+    u, y = record(1200, seed=8, noise=0.01)
+    if kind == "constant":
+        u[400:800] = 3.0
+        y[400:800] = 1.0
+    elif kind == "zeros":
+        u[:] = 0.0
+        y[:] = 0.0
+    else:
+        u[400:800] = np.repeat(rng.standard_normal(100), 4)
+        y[400:800] = np.repeat(rng.standard_normal(100), 4)
+    trace = CLPC(3, 100, 12).run(u, y)
+    for key in ("theta", "den", "num", "D", "eigenvalues", "J", "c", "noise_variance"):
+        assert np.all(np.isfinite(trace.arrays[key])), key
+    if kind == "zeros":
+        assert trace.degenerate.all() and not trace.has_model.any()
+        assert np.all(trace.theta == 0)
+    elif kind == "constant":
+        flat = (trace.index - 2 - 100 >= 400) & (trace.index < 800)
+        assert trace.degenerate[flat].all()
+        assert not trace.accepted[flat].any()
+        # the output holds the last good parameters through the flat part
+        first_flat = np.flatnonzero(flat)[0]
+        last_good = np.flatnonzero(trace.accepted[:first_flat])[-1]
+        np.testing.assert_array_equal(
+            trace.theta[flat], np.broadcast_to(trace.theta[last_good], (flat.sum(), 6))
+        )
+
+
+def test_gate_holds_parameters_when_excitation_is_lost():
+    # a ramp that saturates: once flat, the window no longer determines the model
+    n = 3000
+    rng = np.random.default_rng(9)
+    u = np.concatenate([rng.standard_normal(1000), np.linspace(0, 5, 500), np.full(1500, 5.0)])
+    y = clpc.simulate_arx(DEN, NUM, u) + 1e-3 * rng.standard_normal(n)
+    gated = CLPC(3, 201, 12, gate=True).run(u, y)
+    flat = gated.index > 1500 + 201 + 12
+    assert not gated.accepted[flat].any()
+    good = gated.accepted & (gated.index < 1000)
+    np.testing.assert_allclose(gated.den[flat], np.broadcast_to(DEN, (flat.sum(), 3)), atol=1e-3)
+    assert good.sum() > 50
+
+
+def test_mimo_paired_and_miso():
+    rng = np.random.default_rng(10)
+    u = rng.standard_normal((3000, 2))
+    y = np.column_stack(
+        [clpc.simulate_arx(DEN, NUM, u[:, 0]), clpc.simulate_arx([1, -0.5, 0.1], [1, 0.2, 0], u[:, 1])]
+    )
+    paired = CLPC(3, 201, 12, mimo="paired").run(u, y)
+    assert paired.theta.shape == (len(paired), 2, 6)
+    np.testing.assert_allclose(paired.den[-1], [DEN, [1, -0.5, 0.1]], atol=1e-9)
+    np.testing.assert_allclose(paired.num[-1, 0, 0], NUM, atol=1e-9)
+    np.testing.assert_allclose(paired.num[-1, 0, 1], 0.0)
+    y2 = y[:, 0] + clpc.simulate_arx(DEN, [0.3, 0, 0], u[:, 1])
+    miso = CLPC(3, 201, 12, mimo="miso").run(u, y2)
+    assert miso.theta.shape == (len(miso), 9)
+    np.testing.assert_allclose(miso.den[-1], DEN, atol=1e-9)
+    np.testing.assert_allclose(miso.num[-1], [NUM, [0.3, 0, 0]], atol=1e-9)
+
+
+def test_decimation_by_sample_time():
+    rng = np.random.default_rng(11)
+    u_fast = np.repeat(rng.standard_normal(800), 10) + 0.01 * rng.standard_normal(8000)
+    y_fast = signal.lfilter([0.05], [1, -0.95], u_fast)
+    data = clpc.IOData(u_fast, y_fast, dt=0.001)
+    trace = CLPC(3, 101, 12, sample_time=0.01).run(data)
+    # reference: the same causal filter started at rest at the first sample, every 10th
+    sos = signal.butter(4, 0.08, output="sos")
+    x = np.column_stack([u_fast, y_fast])
+    zi = signal.sosfilt_zi(sos)[:, :, None] * x[0][None, None, :]
+    filt, _ = signal.sosfilt(sos, x, axis=0, zi=zi)
+    ref = CLPC(3, 101, 12, sample_time=0.01).run(filt[::10, 0], filt[::10, 1])
+    np.testing.assert_allclose(trace.theta, ref.theta, atol=1e-12)
+    np.testing.assert_array_equal(trace.index, ref.index)
+    # streaming with the data's sample time gives the same
+    a = CLPC(3, 101, 12, sample_time=0.01, data_sample_time=0.001)
+    streamed = Trace.concat([a.push(u_fast[i : i + 333], y_fast[i : i + 333])
+                             for i in range(0, 8000, 333)])
+    np.testing.assert_allclose(streamed.theta, trace.theta, atol=1e-12)
+    with pytest.raises(DataError, match="integer multiple"):
+        CLPC(3, 101, 12, sample_time=0.015).run(clpc.IOData(u_fast, y_fast, dt=0.01))
+    with pytest.raises(DataError, match="integer multiple"):
+        CLPC(3, 101, 12, sample_time=0.01).run(clpc.IOData(u_fast, y_fast, dt=0.02))
+
+
+def test_threads_give_the_same_result():
+    u, y = record(20000, seed=12, noise=0.01)
+    one = CLPC(3, 201, 12).run(u, y)
+    two = CLPC(3, 201, 12, n_jobs=2).run(u, y)
+    np.testing.assert_array_equal(one.theta, two.theta)
+
+
+def test_to_frame_columns():
+    u, y = record(500, noise=0.01)
+    frame = CLPC(3, 101, 12).run(u, y).to_frame()
+    for col in ("index", "time", "rows", "a0", "a1", "a2", "b0", "b1", "b2", "D", "accepted"):
+        assert col in frame.columns
+
+
+# ---------------------------------------------------------------- validation
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"parameters_size": 1}, "parameters_size must be an int"),
+        ({"window_size": 0}, "window_size must be an int"),
+        ({"cluster_size": 0}, "cluster_size must be an int"),
+        ({"cluster_size": 2.5}, "cluster_size must be an int"),
+        ({"sample_time": -1.0}, "sample_time must be a positive"),
+        ({"method": "lsq"}, "method must be"),
+        ({"min_rows": 1}, "min_rows must be an int"),
+    ],
+)
+def test_constructor_validation(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        CLPC(**kwargs)
+
+
+def test_data_validation():
+    a = CLPC(3, 50, 12)
+    with pytest.raises(DataError, match="same length"):
+        a.push(np.zeros(5), np.zeros(4))
+    with pytest.raises(DataError, match="not finite at sample 3"):
+        a.push([1.0, 2, 3, np.nan], [1.0, 2, 3, 4])
+    a.reset()
+    a.push(np.zeros((5, 1)), np.zeros((5, 1)))
+    with pytest.raises(DataError, match="reset"):
+        a.push(np.zeros((5, 2)), np.zeros((5, 1)))
+    with pytest.raises(DataError, match="not finite"):
+        CLPC(3, 50, 12).step(np.inf, 1.0)
