@@ -132,8 +132,10 @@ def test_push_any_chunking_equals_run(chunks):
     assert len(streamed) == len(batch)
     for key in ("theta", "D", "eigenvalues", "c", "den", "num", "accepted"):
         np.testing.assert_allclose(
-            np.asarray(streamed.arrays[key], float), np.asarray(batch.arrays[key], float),
-            rtol=1e-12, atol=1e-12 * np.abs(np.asarray(batch.arrays[key], float)).max(),
+            np.asarray(streamed.arrays[key], float),
+            np.asarray(batch.arrays[key], float),
+            rtol=1e-12,
+            atol=1e-12 * np.abs(np.asarray(batch.arrays[key], float)).max(),
         )
     np.testing.assert_array_equal(streamed.index, batch.index)
 
@@ -176,7 +178,7 @@ def test_fast_path_equals_exact_recomputation_with_offsets():
     trace = CLPC(3, 201, 12, method="paper").run(u, y)
     for t in range(0, len(trace), 7):
         end_row = (t + 1) * 12
-        scatter, vals, vecs = exact_window(u, y, end_row, 201)
+        _scatter, vals, vecs = exact_window(u, y, end_row, 201)
         np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
         np.testing.assert_allclose(trace.D[t], vals[-1] - vals[0], rtol=1e-9)
         if vals[0] < 0.1 * vals[1]:
@@ -191,7 +193,7 @@ def test_no_drift_over_a_million_samples():
     y = clpc.simulate_arx(DEN, NUM, u - 1e4) + 0.05 * rng.standard_normal(n) + 1e4
     trace = CLPC(3, 201, 12, method="paper").run(u, y)
     for t in (len(trace) - 1, len(trace) // 2, len(trace) - 1000):
-        scatter, vals, vecs = exact_window(u, y, (t + 1) * 12, 201)
+        _scatter, vals, vecs = exact_window(u, y, (t + 1) * 12, 201)
         np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
         ref = vecs[0] * np.sign(vecs[0][0])
         assert vals[0] < 0.1 * vals[1]
@@ -213,7 +215,9 @@ def test_tracks_a_parameter_jump_within_one_window():
     after = trace.index >= 2000 + 201 + 12
     np.testing.assert_allclose(trace.den[after], np.broadcast_to(den2, (after.sum(), 3)), atol=1e-8)
     before = (trace.index < 2000) & trace.accepted
-    np.testing.assert_allclose(trace.den[before], np.broadcast_to(DEN, (before.sum(), 3)), atol=1e-8)
+    np.testing.assert_allclose(
+        trace.den[before], np.broadcast_to(DEN, (before.sum(), 3)), atol=1e-8
+    )
 
 
 @pytest.mark.parametrize("kind", ["constant", "zeros", "repeated"])
@@ -265,7 +269,10 @@ def test_mimo_paired_and_miso():
     rng = np.random.default_rng(10)
     u = rng.standard_normal((3000, 2))
     y = np.column_stack(
-        [clpc.simulate_arx(DEN, NUM, u[:, 0]), clpc.simulate_arx([1, -0.5, 0.1], [1, 0.2, 0], u[:, 1])]
+        [
+            clpc.simulate_arx(DEN, NUM, u[:, 0]),
+            clpc.simulate_arx([1, -0.5, 0.1], [1, 0.2, 0], u[:, 1]),
+        ]
     )
     paired = CLPC(3, 201, 12, mimo="paired").run(u, y)
     assert paired.theta.shape == (len(paired), 2, 6)
@@ -295,8 +302,9 @@ def test_decimation_by_sample_time():
     np.testing.assert_array_equal(trace.index, ref.index)
     # streaming with the data's sample time gives the same
     a = CLPC(3, 101, 12, sample_time=0.01, data_sample_time=0.001)
-    streamed = Trace.concat([a.push(u_fast[i : i + 333], y_fast[i : i + 333])
-                             for i in range(0, 8000, 333)])
+    streamed = Trace.concat(
+        [a.push(u_fast[i : i + 333], y_fast[i : i + 333]) for i in range(0, 8000, 333)]
+    )
     np.testing.assert_allclose(streamed.theta, trace.theta, atol=1e-12)
     with pytest.raises(DataError, match="integer multiple"):
         CLPC(3, 101, 12, sample_time=0.015).run(clpc.IOData(u_fast, y_fast, dt=0.01))

@@ -27,9 +27,10 @@ the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` se
 
 from __future__ import annotations
 
+import itertools
 import json
-from dataclasses import asdict
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
@@ -246,7 +247,7 @@ class CLPC:
         if target is None or dt is None:
             return 1
         ratio = target / dt
-        factor = int(round(ratio))
+        factor = round(ratio)
         if factor < 1 or abs(ratio - factor) > 1e-9 * max(ratio, 1.0):
             raise DataError(
                 f"sample_time={target:g} s must be an integer multiple of the data's sample "
@@ -415,7 +416,7 @@ class CLPC:
                 results = list(
                     pool.map(
                         lambda ab: self._solve_windows(rows, j0 + ab[0], ab[1] - ab[0]),
-                        [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a],
+                        [(a, b) for a, b in itertools.pairwise(bounds) if b > a],
                     )
                 )
             res = {k: np.concatenate([r[k] for r in results]) for k in results[0]}
@@ -525,6 +526,7 @@ class CLPC:
             sample_time=self.sample_time or 1.0,
             input_names=names[0],
             output_names=names[1],
+            meta={"gate": self.gate, "method": self.method},
         )
 
     def _empty_trace(self) -> Trace:

@@ -108,8 +108,10 @@ def window_scatter(
 def _merge_slices(
     pieces: list[tuple[int, int, np.ndarray, np.ndarray]], first: int, count: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Merge pieces for ``count`` consecutive windows; piece offset ``o`` of window ``w``
-    is block ``first + w + o`` (parallel formula of the module docstring)."""
+    """Merge pieces for ``count`` consecutive windows (parallel formula of the module docstring).
+
+    Piece offset ``o`` of window ``w`` is block ``first + w + o``.
+    """
     n_rows = float(sum(size for _, size, _, _ in pieces))
     total = sum(size * means[:, first + o : first + o + count] for o, size, means, _ in pieces)
     mean = total / n_rows
