@@ -16,6 +16,7 @@ from .order import OrderSelection, select_order
 from .regressors import Structure
 from .solve import RobustRule
 from .trace import Convergence, Trace
+from .verdict import Verdict, describe_trace, fit_verdict
 
 __version__ = "0.1.0"
 
@@ -32,8 +33,11 @@ __all__ = [
     "RobustRule",
     "Structure",
     "Trace",
+    "Verdict",
     "as_iodata",
+    "describe_trace",
     "fit_percent",
+    "fit_verdict",
     "kstep_fit",
     "lpc_solve",
     "rmse",
