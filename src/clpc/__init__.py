@@ -9,9 +9,11 @@ machine and reports time-varying parameters and the degree of linearity of each 
 from .appraiser import CLPC
 from .arx import ARX, simulate_arx
 from .data import DataError, IOData, as_iodata
+from .io import load_iodata, read_table, write_table
 from .lpc import LPC, lpc_solve
 from .metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
 from .model import LinearModel, ModelError
+from .model_io import load_model, save_model
 from .order import OrderSelection, select_order
 from .regressors import Structure
 from .solve import RobustRule
@@ -23,8 +25,8 @@ __version__ = "0.1.0"
 __all__ = [
     "ARX",
     "CLPC",
-    "Convergence",
     "LPC",
+    "Convergence",
     "DataError",
     "IOData",
     "LinearModel",
@@ -39,10 +41,15 @@ __all__ = [
     "fit_percent",
     "fit_verdict",
     "kstep_fit",
+    "load_iodata",
+    "load_model",
     "lpc_solve",
+    "read_table",
     "rmse",
+    "save_model",
     "select_order",
     "simulate_arx",
     "vaf",
     "whiteness_test",
+    "write_table",
 ]
