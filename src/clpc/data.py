@@ -63,7 +63,8 @@ def _to_2d_float(values: Any, name: str) -> tuple[np.ndarray, list[str] | None]:
         )
     if arr.shape[0] == 0 or arr.shape[1] == 0:
         raise DataError(f"{name} is empty (shape {arr.shape}); at least one sample is needed.")
-    return np.ascontiguousarray(arr), columns
+    # an owned copy: the caller's array is neither aliased nor made read-only
+    return np.array(arr, dtype=np.float64, order="C", copy=True), columns
 
 
 def _check_finite(arr: np.ndarray, name: str, channels: Sequence[str]) -> None:

@@ -63,12 +63,19 @@ def rmse(y: Any, y_hat: Any) -> Any:
 
 
 def vaf(y: Any, y_hat: Any) -> Any:
-    """Variance accounted for, ``100 (1 - var(y - y_hat) / var(y))`` in percent."""
+    """Variance accounted for, ``100 (1 - var(y - y_hat) / var(y))`` in percent.
+
+    A constant ``y`` gives 100 when the error is constant too, else ``-inf`` (as
+    :func:`fit_percent`).
+    """
     a, b, one = _pair(y, y_hat)
     var = np.var(a, axis=0)
+    err_var = np.var(a - b, axis=0)
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.where(
-            var > 0, 100.0 * (1.0 - np.var(a - b, axis=0) / np.where(var > 0, var, 1)), 100.0
+            var > 0,
+            100.0 * (1.0 - err_var / np.where(var > 0, var, 1)),
+            np.where(err_var == 0, 100.0, -np.inf),
         )
     return _out(out, one)
 

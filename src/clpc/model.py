@@ -173,12 +173,20 @@ class LinearModel:
         return all(np.all(np.abs(self.poles(j)) < 1.0) for j in range(self.n_outputs))
 
     def dc_gain(self) -> np.ndarray:
-        """Static gains ``G(1)``, shape (n_outputs, n_inputs); ``inf`` for an integrator."""
-        den_sum = self.denominators.sum(axis=1)[:, None]
-        num_sum = self.numerators.sum(axis=2)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gain = num_sum / den_sum
-        return np.where(np.abs(den_sum) < 1e-12, np.inf * np.sign(num_sum + 0.0), gain)
+        """Static gains ``G(1)``, shape (n_outputs, n_inputs).
+
+        ``A(1) = 0`` (an integrator) gives ``+-inf`` (the sign of ``B(1)``), or 0 for a
+        channel whose numerator is identically zero (e.g. the off-diagonal channels of a
+        ``"paired"`` model); ``nan`` when ``B(1) = A(1) = 0`` (a cancelled pole at 1).
+        """
+        nums = self.numerators
+        den_sum = np.broadcast_to(self.denominators.sum(axis=1)[:, None], nums.shape[:2])
+        num_sum = nums.sum(axis=2)
+        integ = np.abs(den_sum) < 1e-12
+        gain = np.divide(num_sum, den_sum, out=np.full(num_sum.shape, np.nan), where=~integ)
+        at_pole = np.where(num_sum != 0, np.copysign(np.inf, num_sum), np.nan)
+        at_pole[~np.any(nums != 0, axis=2)] = 0.0
+        return np.where(integ, at_pole, gain)
 
     def frequency_response(
         self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
@@ -357,7 +365,15 @@ class LinearModel:
                 "on or outside the unit circle (a non-minimum-phase model). Pass "
                 "allow_unstable=True to compute it anyway."
             )
-        past = np.full(s.na, yv[0]) if y_init is None else np.asarray(y_init, float)[-s.na :]
+        if y_init is None:
+            past = np.full(s.na, yv[0])
+        else:
+            past = np.asarray(y_init, dtype=np.float64).ravel()
+            if past.size < s.na:
+                raise ValueError(
+                    f"y_init must hold the last {s.na} outputs before y[0]; got {past.size}."
+                )
+            past = past[past.size - s.na :]
         y_ext = np.concatenate([past, yv])
         w = signal.lfilter(self.den, [1.0], y_ext)[s.na :] - self.intercept[0]
         u_hat = signal.lfilter([1.0], num, w)
@@ -374,6 +390,9 @@ class LinearModel:
     def to_scipy(self, output: int = 0, input: int = 0) -> signal.dlti:
         """Export one channel pair as :class:`scipy.signal.dlti` (``dt`` = sample time)."""
         num, den = self._padded(output, input)
+        # leading zeros (input delay nk) are zero high-power coefficients: dropping them keeps
+        # G(z) and spares scipy's "badly conditioned numerator" warning
+        num = np.trim_zeros(num, "f") if np.any(num) else num[-1:]
         return signal.dlti(num, den, dt=self.dt)
 
     def to_control(self) -> Any:

@@ -44,10 +44,16 @@ class RobustRule:
         An eigenvector of the whitened scatter matrix is a candidate system relation when
         its ``y(n)`` component ``|v[a0]|`` is at least this (0..1). Smaller eigenvectors
         below the first candidate are relations that do not determine ``y(n)``.
-    degeneracy_ratio : float
+    degeneracy_ratio : float, optional
         Eigenvalues within this factor of the candidate's belong to the same near-null
         subspace (the noise cannot tell them apart); the solution is then the minimum-norm
-        vector with ``a0 = 1`` in that subspace.
+        vector with ``a0 = 1`` in that subspace. Default: the ratio of the edges of the
+        Marchenko-Pastur law, ``((1 + sqrt(p/n)) / (1 - sqrt(p/n)))^2`` (the spread of the
+        eigenvalues of pure noise with ``n`` rows and ``p`` columns; 2.0 for ``p = 6, n = 200``
+        and 1.03 for ``n = 1e5``), at most 4.
+    zero_tol : float
+        Eigenvalues below ``zero_tol * lambda_max`` are zero (rounding level): they are
+        always in the near-null subspace, whatever their ratios.
     min_output_weight : float
         An eigenvector whose output block ``||v[y]||^2`` is below this is an input-only
         relation (the input is not persistently exciting).
@@ -57,7 +63,8 @@ class RobustRule:
     """
 
     min_a0_weight: float = 0.1
-    degeneracy_ratio: float = 2.0
+    degeneracy_ratio: float | None = None
+    zero_tol: float = 1e-12
     min_output_weight: float = 0.05
     separation: float = 0.1
 
@@ -202,7 +209,8 @@ def solve_scatter(
         nxt = vals[:, 1] if p > 1 else vals[:, 0]
         separation = _ratio(vals[:, 0], nxt)
     else:
-        phi, n_null, n_input, separation = _robust_vector(vals, vecs, n_output_cols, rule)
+        ratio = degeneracy_ratio(rule, n_rows, p)
+        phi, n_null, n_input, separation = _robust_vector(vals, vecs, n_output_cols, rule, ratio)
 
     theta = phi if transform is None else np.einsum("kij,kj->ki", transform, phi)
     theta = _normalise(theta)
@@ -281,8 +289,18 @@ def _decompose(
     return np.linalg.eigh(mat)
 
 
+def degeneracy_ratio(rule: RobustRule, n_rows: np.ndarray, p: int) -> np.ndarray:
+    """Eigenvalue ratio within which directions are indistinguishable (see RobustRule)."""
+    if rule.degeneracy_ratio is not None:
+        return np.full(np.shape(n_rows), float(rule.degeneracy_ratio))
+    x = np.sqrt(p / np.maximum(np.asarray(n_rows, dtype=float), 1.0))
+    with np.errstate(divide="ignore"):
+        mp = np.where(x < 1, ((1 + x) / np.maximum(1 - x, 1e-12)) ** 2, np.inf)
+    return np.minimum(mp, 4.0)
+
+
 def _robust_vector(
-    vals: np.ndarray, vecs: np.ndarray, n_output_cols: int, rule: RobustRule
+    vals: np.ndarray, vecs: np.ndarray, n_output_cols: int, rule: RobustRule, ratio: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Minimum-norm ``a0 = 1`` vector in the near-null subspace, vectorised over windows."""
     k, p = vals.shape
@@ -292,8 +310,9 @@ def _robust_vector(
     cand = np.abs(a0) >= rule.min_a0_weight
     # first candidate; if none qualifies, the eigenvector with the largest y(n) component
     first = np.where(cand.any(axis=1), np.argmax(cand, axis=1), np.argmax(np.abs(a0), axis=1))
-    lam_s = np.maximum(vals[np.arange(k), first], 0.0)
-    within = (np.maximum(vals, 0.0) <= rule.degeneracy_ratio * lam_s[:, None]) | (
+    floor = rule.zero_tol * np.maximum(vals[:, -1], 0.0)
+    lam_s = np.maximum(vals[np.arange(k), first], floor)
+    within = (np.maximum(vals, 0.0) <= ratio[:, None] * lam_s[:, None]) | (
         idx[None, :] <= first[:, None]
     )
     # the near-null subspace is a leading block of the ascending spectrum
@@ -301,7 +320,7 @@ def _robust_vector(
     member = idx[None, :] <= last[:, None]
     # projection of e_a0 onto span(v_0..v_last): sum_i v_i v_i[a0]
     phi = np.einsum("kpi,ki->kp", vecs, np.where(member, a0, 0.0))
-    n_null = (last - first + 1).astype(np.int64)
+    n_null = (last + 1).astype(np.int64)
     n_input = np.sum(member & (out_w < rule.min_output_weight), axis=1).astype(np.int64)
     nxt = np.where(last + 1 < p, vals[np.arange(k), np.minimum(last + 1, p - 1)], np.inf)
     separation = np.where(
