@@ -138,7 +138,7 @@ def test_settings_of_the_estimator_are_kept(order3):
 @pytest.mark.parametrize(
     ("kwargs", "pattern"),
     [
-        ({"criterion": "mdl"}, "criterion must be 'remark1', 'aic' or 'bic'; got 'mdl'"),
+        ({"criterion": "mdl"}, "criterion must be .* or 'validation'; got 'mdl'"),
         ({"orders": [0, 1]}, r"orders must be ints >= 1; got \[0, 1\]"),
         ({"orders": []}, r"orders must be ints >= 1; got \[\]"),
     ],
@@ -151,3 +151,17 @@ def test_validation(kwargs, pattern):
 
 def test_exported():
     assert clpc.select_order is select_order
+
+
+def test_validation_criterion_picks_the_predictive_order():
+    rng = np.random.default_rng(21)
+    u = rng.standard_normal(6000)
+    y0 = clpc.simulate_arx([1.0, -1.5, 0.7, -0.1], [0.2, 0.5, 0.1, 0.05], u)
+    y = y0 + 0.05 * rng.standard_normal(6000)
+    sel = clpc.select_order(u, y, orders=[1, 2, 3, 4, 5], criterion="validation")
+    assert sel.validation_fit is not None and sel.validation_fit.shape == (5,)
+    # order 1 and 2 miss dynamics: their held-out 10-step fit is clearly worse than order 3
+    assert sel.validation_fit[2] > sel.validation_fit[0] + 1.0
+    assert sel.best >= 3
+    with pytest.raises(ValueError, match="validation_fraction"):
+        clpc.select_order(u, y, criterion="validation", validation_fraction=1.5)

@@ -42,6 +42,7 @@ class OrderSelection:
     n_params: np.ndarray
     best: int
     criterion: str
+    validation_fit: np.ndarray | None = None
 
     def to_frame(self) -> Any:
         """The table as a pandas DataFrame (needs pandas)."""
@@ -69,6 +70,8 @@ def select_order(
     min_improvement: float = 0.1,
     estimator: LPC | None = None,
     dt: float | None = None,
+    k: int = 10,
+    validation_fraction: float = 1.0 / 3.0,
 ) -> OrderSelection:
     """Choose the model order ``N`` (``na = nb = N``).
 
@@ -78,21 +81,35 @@ def select_order(
         The record (see :meth:`clpc.LPC.fit`).
     orders : iterable of int
         Candidate orders, ascending.
-    criterion : {"remark1", "aic", "bic"}
+    criterion : {"remark1", "aic", "bic", "validation"}
         ``"remark1"``: the paper's rule - from the lowest order, raise ``N`` while the
         noise variance (hence ``J``) falls by at least ``min_improvement`` (relative);
-        ``"aic"``/``"bic"``: the minimum of the information criterion.
+        ``"aic"``/``"bic"``: the minimum of the information criterion;
+        ``"validation"``: fit on the first ``1 - validation_fraction`` of the record and
+        take the order with the best ``k``-step-ahead prediction fit % on the rest (the
+        criterion that works on real data, where the likelihood keeps rising with the
+        order).
     min_improvement : float
         Relative decrease of ``sigma_r^2`` that counts as meaningful for ``"remark1"``.
     estimator : LPC, optional
         Settings (method, weighting, delay); its order is replaced.
+    k : int
+        Prediction horizon for ``"validation"``.
+    validation_fraction : float
+        Share of the record held out for ``"validation"`` (0 < f < 1).
 
     Returns
     -------
     OrderSelection
     """
-    if criterion not in ("remark1", "aic", "bic"):
-        raise ValueError(f"criterion must be 'remark1', 'aic' or 'bic'; got {criterion!r}.")
+    if criterion not in ("remark1", "aic", "bic", "validation"):
+        raise ValueError(
+            f"criterion must be 'remark1', 'aic', 'bic' or 'validation'; got {criterion!r}."
+        )
+    if not 0.0 < validation_fraction < 1.0:
+        raise ValueError(
+            f"validation_fraction must be in (0, 1); got {validation_fraction!r}."
+        )
     orders = np.array(sorted({int(o) for o in orders}))
     if orders.size == 0 or orders[0] < 1:
         raise ValueError(f"orders must be ints >= 1; got {orders.tolist()}.")
@@ -106,20 +123,24 @@ def select_order(
         model = est.fit(data[skip:])
         info = model.info
         n = int(info["n_rows"][0])
-        k = (model.theta.shape[1] - 1 + 2) * model.n_outputs
+        n_free = (model.theta.shape[1] - 1 + 2) * model.n_outputs
         ll = float(np.sum(info["log_likelihood"]))
         rows.append(
             (
                 float(np.sum(info["J"])),
                 ll,
-                2 * k - 2 * ll,
-                k * np.log(n) - 2 * ll,
+                2 * n_free - 2 * ll,
+                n_free * np.log(n) - 2 * ll,
                 float(np.sum(info["noise_variance"])),
-                k,
+                n_free,
             )
         )
-    J, ll, aic, bic, var, k = (np.array(col) for col in zip(*rows, strict=False))
-    if criterion == "aic":
+    J, ll, aic, bic, var, n_par = (np.array(col) for col in zip(*rows, strict=True))
+    val_fit = None
+    if criterion == "validation":
+        val_fit = _validation_fits(data, base, orders, k, validation_fraction)
+        best = int(orders[np.argmax(val_fit)])
+    elif criterion == "aic":
         best = int(orders[np.argmin(aic)])
     elif criterion == "bic":
         best = int(orders[np.argmin(bic)])
@@ -130,4 +151,24 @@ def select_order(
                 best = int(orders[i])
             else:
                 break
-    return OrderSelection(orders, J, ll, aic, bic, var, k.astype(int), best, criterion)
+    return OrderSelection(
+        orders, J, ll, aic, bic, var, n_par.astype(int), best, criterion, val_fit
+    )
+
+
+def _validation_fits(
+    data: Any, base: LPC, orders: np.ndarray, k: int, fraction: float
+) -> np.ndarray:
+    """``k``-step-ahead fit % on the held-out tail, per order (summed over outputs' errors)."""
+    split = round(data.n_samples * (1.0 - fraction))
+    est, val = data[:split], data[split:]
+    fits = []
+    for order in orders:
+        model = replace(base, order=int(order), na=None, nb=None).fit(est)
+        y_hat = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
+        start = model.structure.max_lag
+        err = np.linalg.norm(val.y[start:] - y_hat[start:])
+        ref = np.linalg.norm(val.y[start:] - val.y[start:].mean(axis=0))
+        ok = np.isfinite(err) and ref > 0
+        fits.append(100.0 * (1.0 - err / ref) if ok else -np.inf)
+    return np.array(fits)
