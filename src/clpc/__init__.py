@@ -14,6 +14,7 @@ from .lpc import LPC, lpc_solve
 from .metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
 from .model import LinearModel, ModelError
 from .model_io import load_model, save_model
+from .noise import NoiseEstimate, estimate_noise_variances
 from .order import OrderSelection, select_order
 from .regressors import Structure
 from .solve import RobustRule
@@ -31,6 +32,7 @@ __all__ = [
     "IOData",
     "LinearModel",
     "ModelError",
+    "NoiseEstimate",
     "OrderSelection",
     "RobustRule",
     "Structure",
@@ -38,6 +40,7 @@ __all__ = [
     "Verdict",
     "as_iodata",
     "describe_trace",
+    "estimate_noise_variances",
     "fit_percent",
     "fit_verdict",
     "kstep_fit",

@@ -1,0 +1,39 @@
+import numpy as np
+import pytest
+
+import clpc
+from clpc import DataError
+from clpc.noise import estimate_noise_variances
+
+DEN = np.array([1.0, -1.5, 0.7])
+NUM = np.array([0.2, 0.5, 0.1])
+
+
+def eiv(seed, n=50_000, su=0.3, sy=0.1):
+    rng = np.random.default_rng(seed)
+    u0 = rng.standard_normal(n)
+    y0 = clpc.simulate_arx(DEN, NUM, u0)
+    scale = y0.std()
+    return u0 + su * rng.standard_normal(n), y0 / scale + sy * rng.standard_normal(n), scale
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_noise_variances_recovered_and_make_weighted_lpc_consistent(seed):
+    u, y, scale = eiv(seed)
+    est = estimate_noise_variances(u, y, order=2)
+    assert est.converged
+    assert est.output_variance == pytest.approx(0.01, rel=0.1)
+    assert est.input_variance == pytest.approx(0.09, rel=0.1)
+    weighted = clpc.LPC(order=2, noise_ratio=est.ratio).fit(u, y)
+    plain = clpc.LPC(order=2, method="paper").fit(u, y)
+    true = np.concatenate([DEN, NUM / scale])
+    err_w = np.linalg.norm(np.concatenate([weighted.den, weighted.num]) - true)
+    err_p = np.linalg.norm(np.concatenate([plain.den, plain.num]) - true)
+    assert err_w < 0.01 < err_p
+
+
+def test_noise_estimate_validation():
+    with pytest.raises(ValueError, match="extra_lags"):
+        estimate_noise_variances(np.ones(100), np.arange(100.0), extra_lags=0)
+    with pytest.raises(DataError, match="one input and one output"):
+        estimate_noise_variances(np.ones((100, 2)), np.arange(100.0))
