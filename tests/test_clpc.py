@@ -356,3 +356,26 @@ def test_data_validation():
         a.push(np.zeros((5, 2)), np.zeros((5, 1)))
     with pytest.raises(DataError, match="not finite"):
         CLPC(3, 50, 12).step(np.inf, 1.0)
+
+
+def test_constant_command_after_a_ramp_is_degenerate():
+    # merged statistics of a constant channel are ~1e-29, not 0: still flagged
+    rng = np.random.default_rng(13)
+    u = np.r_[np.linspace(0, 1, 100), np.ones(900)]
+    y = u + 1e-5 * rng.standard_normal(1000)
+    trace = CLPC(3, 201, 12).run(u, y)
+    late = trace.index > 400
+    assert trace.degenerate[late].all()
+    assert not trace.accepted[late].any()
+
+
+def test_estimates_without_y_are_never_accepted():
+    # paper method on a ramp: the smallest eigenvector is the ramp's own relation (a0 ~ 0)
+    rng = np.random.default_rng(14)
+    u = np.clip(np.arange(3000) / 1500.0, 0, 1) + 1e-7 * rng.standard_normal(3000)
+    y = clpc.simulate_arx(DEN, NUM, u) + 1e-3 * rng.standard_normal(3000)
+    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    weak = trace.arrays["a0_weight"][:, 0] < 1e-3
+    assert weak.any()
+    assert not trace.accepted[weak].any()
+    assert np.all(np.isfinite(trace.den)) and np.abs(trace.den).max() < 1e3

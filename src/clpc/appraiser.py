@@ -45,7 +45,10 @@ from .trace import Trace
 
 __all__ = ["CLPC"]
 
-_WINDOWS_PER_BATCH = 4096
+_WINDOWS_PER_BATCH = 2048
+# an estimate whose y(n) coefficient is below this in the solved (whitened) problem does not
+# determine y(n): it has no usable monic form and is never accepted
+_MIN_A0_WEIGHT = 1e-3
 
 
 def _positive_int(value: Any, name: str, low: int = 1) -> int:
@@ -442,7 +445,7 @@ class CLPC:
             rule=self.rule,
         )
         info = fit_info(res, n_eq_rows, self.rule)
-        out = {"theta_estimate": res.theta, "n_rows_win": n_rows}
+        out = {"theta_estimate": res.theta, "n_rows_win": n_rows, "a0_weight": res.a0_weight}
         for key in ("eigenvalues", "lambda_min", "lambda_max", "D", "eig_ratio", "separation",
                     "noise_variance", "J", "c", "n_null", "n_input_relations", "degenerate",
                     "determined"):
@@ -461,7 +464,7 @@ class CLPC:
         n_rows = res.pop("n_rows_win")
         not_enough = n_rows < self._min_rows()
         est = res["theta_estimate"]
-        a0_ok = est[:, :, 0] > 1e-9
+        a0_ok = res["a0_weight"] >= _MIN_A0_WEIGHT
         accepted = ~not_enough[:, None] & ~res["degenerate"] & a0_ok
         if self.gate:
             accepted &= res["determined"]
@@ -544,7 +547,7 @@ class CLPC:
         arrays = {}
         for key in ("theta", "theta_estimate", "den", "num", "eigenvalues", "lambda_min",
                     "lambda_max", "D", "eig_ratio", "separation", "noise_variance", "J", "c",
-                    *ints, *bools):
+                    "a0_weight", *ints, *bools):
             dtype = np.int64 if key in ints else (bool if key in bools else np.float64)
             arrays[key] = np.zeros((0, e, *shapes.get(key, ())), dtype=dtype)
         z = np.zeros(0)

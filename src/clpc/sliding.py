@@ -22,6 +22,7 @@ statistics are never accumulated over the record) lose no digits. Cost per windo
 from __future__ import annotations
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 __all__ = ["block_stats", "window_scatter"]
 
@@ -94,15 +95,50 @@ def window_scatter(
     out_n = np.empty(n_windows, dtype=np.int64)
     if j_full < j1:
         sel = slice(j_full - j0, n_windows)
-        out_s[:, sel], out_m[:, sel], out_n[sel] = _merge_slices(
-            pieces, j_full - lo_block, j1 - j_full
+        tail = (t_mean, t_scat) if r else None
+        out_s[:, sel], out_m[:, sel] = _merge_full(
+            f_mean, f_scat, tail, j_full - lo_block, j1 - j_full, q, cluster, r
         )
+        out_n[sel] = window
     # ... and the first ones, still growing (at most q + 1 of them): pieces may not exist
     for jj in range(j0, min(j_full, j1)):
         use = [pc for pc in pieces if jj + pc[0] >= 0]
         s_, m_, n_ = _merge_slices(use, jj - lo_block, 1)
         out_s[:, jj - j0], out_m[:, jj - j0], out_n[jj - j0] = s_[:, 0], m_[:, 0], n_[0]
     return out_s, out_m, out_n
+
+
+def _merge_full(
+    f_mean: np.ndarray,
+    f_scat: np.ndarray,
+    tail: tuple[np.ndarray, np.ndarray] | None,
+    first: int,
+    count: int,
+    q: int,
+    cluster: int,
+    r: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Merge ``q`` full blocks (+ a tail) for ``count`` consecutive full windows at once.
+
+    Window ``w`` uses full blocks ``first + w - q .. first + w - 1`` and the tail of block
+    ``first + w - q - 1``; strided views stack the pieces without copying the scatters.
+    """
+    lo = first - q
+    means = sliding_window_view(f_mean[:, lo : lo + count + q - 1], q, axis=1)  # (E,k,p,q)
+    within = f_scat[:, lo : lo + count].copy()
+    for o in range(1, q):  # a loop over the q blocks of a window, vectorised over windows
+        within += f_scat[:, lo + o : lo + o + count]
+    weights = np.full(q, float(cluster))
+    if tail is not None:
+        t_mean, t_scat = tail
+        means = np.concatenate([means, t_mean[:, lo - 1 : lo - 1 + count, :, None]], axis=-1)
+        within += t_scat[:, lo - 1 : lo - 1 + count]
+        weights = np.append(weights, float(r))
+    mean = means @ (weights / weights.sum())  # (E, k, p)
+    dev = means - mean[..., None]
+    dev *= np.sqrt(weights)  # in place: large temporaries cost more than the arithmetic
+    within += dev @ np.swapaxes(dev, -1, -2)
+    return within, mean
 
 
 def _merge_slices(

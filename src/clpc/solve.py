@@ -94,7 +94,10 @@ class SolveResult:
         Solved eigenvalue of the solution over the next eigenvalue outside the near-null
         subspace (small: well determined; near 1: not determined by the data).
     degenerate : ndarray of bool, shape (batch...)
-        The scatter matrix is (numerically) zero or has a zero channel: nothing to fit.
+        The scatter matrix is (numerically) zero or has a constant channel: nothing to fit.
+    a0_weight : ndarray, shape (batch...)
+        ``|y(n)|`` component of the solution in the solved (whitened) problem, unit-free;
+        near 0 the solution does not determine ``y(n)`` and has no monic form.
     """
 
     theta: np.ndarray
@@ -106,6 +109,7 @@ class SolveResult:
     n_input_relations: np.ndarray
     separation: np.ndarray
     degenerate: np.ndarray
+    a0_weight: np.ndarray
 
 
 def channel_scales(scatter: np.ndarray, n_rows: np.ndarray, blocks: list[slice]) -> np.ndarray:
@@ -195,10 +199,17 @@ def solve_scatter(
 
     # degenerate: nothing varies in the window, or a channel is constant
     diag = np.diagonal(scatter, axis1=-2, axis2=-1)
+    # a channel is constant when its spread is at rounding level relative to its own size
+    # (|mean| * 1e-12) or to the whole matrix; merged statistics of a constant channel are
+    # ~1e-29, not 0
     channel_var = np.stack([diag[:, b].max(axis=1) for b in blocks], axis=1)
+    channel_size = np.stack([np.abs(mean[:, b]).max(axis=1) for b in blocks], axis=1)
+    per_row = channel_var / n_safe[:, None]
     top = np.maximum(raw_vals[:, -1], 0.0)
     degenerate = ~(top > 0) | np.any(
-        channel_var <= 1e-28 * np.maximum(top, 1e-300)[:, None], axis=1
+        (channel_var <= 1e-28 * np.maximum(top, 1e-300)[:, None])
+        | (per_row <= (1e-12 * channel_size) ** 2),
+        axis=1,
     )
 
     if method == "paper":
@@ -212,6 +223,8 @@ def solve_scatter(
         ratio = degeneracy_ratio(rule, n_rows, p)
         phi, n_null, n_input, separation = _robust_vector(vals, vecs, n_output_cols, rule, ratio)
 
+    phi_norm = np.linalg.norm(phi, axis=1)
+    a0_weight = np.abs(phi[:, 0]) / np.where(phi_norm > 0, phi_norm, 1.0)
     theta = phi if transform is None else np.einsum("kij,kj->ki", transform, phi)
     theta = _normalise(theta)
     theta[degenerate] = 0.0
@@ -227,6 +240,7 @@ def solve_scatter(
         n_input_relations=n_input,
         separation=separation,
         degenerate=degenerate,
+        a0_weight=np.where(degenerate, 0.0, a0_weight),
     )
 
 

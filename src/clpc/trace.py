@@ -24,6 +24,7 @@ _PER_EQUATION = (
     "D",
     "eig_ratio",
     "separation",
+    "a0_weight",
     "noise_variance",
     "J",
     "c",
