@@ -1,0 +1,230 @@
+"""The section VI experiment (clpc.experiment): outputs, the paper's claims, the helpers.
+
+One shortened run (``quick=True``) is shared by the module; every assertion on it checks a
+property the rig could fail (a stable control-system model, a pole at z = 1, D settling),
+not a stored number.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from scipy import signal
+
+import clpc
+from clpc import experiment as ex
+from clpc.experiment_report import render_report
+from clpc.paper_figures import FILES, RICH_FILE
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], Path]:
+    out = tmp_path_factory.mktemp("experiment")
+    return ex.run_experiment(out, quick=True, seed=0), out
+
+
+# ---------------------------------------------------------------- outputs
+def test_all_figures_and_reports_are_written(run: tuple[dict[str, Any], Path]) -> None:
+    summary, out = run
+    names = [*FILES.values(), RICH_FILE]
+    assert len(FILES) == 13
+    for name in names:
+        data = (out / name).read_bytes()
+        assert data[:8] == PNG_MAGIC, name
+        assert len(data) > 5000, name
+    assert json.loads((out / "summary.json").read_text()) == summary
+    report = (out / "report.md").read_text()
+    for name in names:
+        assert f"({name})" in report, f"{name} is not shown in the report"
+    for claim in summary["claims"]:
+        assert claim["paper"] in report
+
+
+def test_report_rerenders_from_saved_summary(run: tuple[dict[str, Any], Path]) -> None:
+    _, out = run
+    saved = json.loads((out / "summary.json").read_text())
+    assert render_report(saved) == (out / "report.md").read_text()
+
+
+def test_settings_are_table_1(run: tuple[dict[str, Any], Path]) -> None:
+    s = run[0]["settings"]
+    assert (s["sample_time"], s["parameters_size"], s["window_size"], s["cluster_size"]) == (
+        0.01,
+        3,
+        201,
+        12,
+    )
+    assert s["window_time"] == pytest.approx(2.0)
+
+
+def test_every_claim_has_a_verdict_for_both_commands(run: tuple[dict[str, Any], Path]) -> None:
+    verdicts = {ex_verdict for ex_verdict in ("reproduced", "partly", "not reproduced")}
+    for claim in run[0]["claims"]:
+        for name in ("ramp", "rich"):
+            if name in claim:
+                assert claim[name]["verdict"] in verdicts
+                assert claim[name]["numbers"]
+
+
+# ---------------------------------------------------------------- the paper's claims
+def test_ramp_excites_only_at_its_corners(run: tuple[dict[str, Any], Path]) -> None:
+    cmds = run[0]["commands"]
+    ramp, rich = cmds["ramp"]["excitation"], cmds["rich"]["excitation"]
+    assert ramp["second_difference_nonzero_samples"] <= 4
+    assert (
+        rich["second_difference_nonzero_fraction"] > 50 * ramp["second_difference_nonzero_fraction"]
+    )
+
+
+@pytest.mark.parametrize("name", ["ramp", "rich"])
+def test_d_rises_while_the_window_fills(run: tuple[dict[str, Any], Path], name: str) -> None:
+    d = run[0]["commands"][name]["control_system"]["D"]
+    assert d["fill"]["rising_fraction"] >= 0.8
+    assert d["fill"]["last"] > 100 * d["fill"]["first"]
+
+
+def test_d_is_quasi_constant_after_the_fill_for_the_rich_command(
+    run: tuple[dict[str, Any], Path],
+) -> None:
+    for ident in ("control_system", "actuator"):
+        d = run[0]["commands"]["rich"][ident]["D"]
+        assert d["after_fill"]["cv"] < d["fill"]["cv"]
+        assert d["after_fill"]["cv"] < ex.D_QUASI_CONSTANT
+        assert d["quasi_constant_after_fill"] and d["more_constant_after_fill"]
+
+
+def test_the_ramp_d_is_not_constant_after_the_fill(run: tuple[dict[str, Any], Path]) -> None:
+    d = run[0]["commands"]["ramp"]["control_system"]["D"]
+    assert d["after_fill"]["last"] < 0.1 * d["after_fill"]["max"]  # the ramp leaves the window
+    assert not d["quasi_constant_after_fill"]
+
+
+def test_parameters_converge_for_the_rich_command(run: tuple[dict[str, Any], Path]) -> None:
+    for ident in ("control_system", "actuator"):
+        p = run[0]["commands"]["rich"][ident]["parameters"]
+        assert p["converged"] and p["tolerance_level"] == 0
+        assert 1 <= p["cluster"] <= 60
+        assert p["theta_variation"] < 0.2
+
+
+@pytest.mark.parametrize("name", ["ramp", "rich"])
+def test_control_system_model_is_stable_and_follows_the_command(
+    run: tuple[dict[str, Any], Path],
+    name: str,
+) -> None:
+    cs = run[0]["commands"][name]["control_system"]
+    assert cs["model"]["stable"]
+    assert max(cs["model"]["pole_radius"]) < 0.95
+    assert cs["model"]["dc_gain"] == pytest.approx(1.0, abs=0.02)
+    assert cs["baselines"]["clpc"]["simulation_fit"] > 95.0
+
+
+def test_actuator_has_an_integrating_pole(run: tuple[dict[str, Any], Path]) -> None:
+    summary = run[0]
+    act = summary["commands"]["rich"]["actuator"]
+    assert act["model"]["pole_distance_to_1"] < 0.05
+    assert abs(act["model"]["den_sum"]) < 0.01  # A(1) ~ 0: an integrator
+    assert max(summary["rigid_body"]["poles"]) == pytest.approx(1.0, abs=1e-9)
+    assert act["baselines"]["clpc"]["k1_fit"] > 95.0
+
+
+def test_rich_command_estimates_the_torque_better_than_the_ramp(
+    run: tuple[dict[str, Any], Path],
+) -> None:
+    cmds = run[0]["commands"]
+    rich, ramp = cmds["rich"]["actuator"], cmds["ramp"]["actuator"]
+    assert rich["torque_fit"] >= 50.0
+    assert rich["torque_fit"] > ramp["torque_fit"]
+    assert rich["causal_inverse"].startswith("refused")  # non-minimum-phase sampling zero
+    assert not rich["torque_error"]["diverged"]
+
+
+def test_ramp_position_error_converges(run: tuple[dict[str, Any], Path]) -> None:
+    e = run[0]["commands"]["ramp"]["control_system"]["position_error"]
+    assert not e["diverged"]
+    assert e["rms_last_second"] < e["rms_first_second"]
+    assert e["rms_last_second"] < 1e-3  # rad, on a 1 rad move
+
+
+def test_baselines_are_computed(run: tuple[dict[str, Any], Path]) -> None:
+    for name in ("ramp", "rich"):
+        cs = run[0]["commands"][name]["control_system"]["baselines"]
+        act = run[0]["commands"][name]["actuator"]["baselines"]
+        for key in ("clpc", "lpc", "arx"):
+            assert cs[key]["simulation_fit"] is not None
+            for k in ("k1_fit", "k10_fit"):
+                assert np.isfinite(cs[key][k]) and np.isfinite(act[key][k])
+        assert 0 < cs["clpc_online"]["coverage"] <= 1
+
+
+def test_extended_ramp_leaves_nothing_to_identify(run: tuple[dict[str, Any], Path]) -> None:
+    ext = run[0]["extended_ramp"]
+    assert ext["constant_command_windows"] > ext["updates_after_ramp_left_window"] // 2
+    assert ext["D_last"] < 1e-3 * ext["D_max"]
+
+
+# ---------------------------------------------------------------- helpers
+def test_decimate_matches_the_appraiser(rng: np.random.Generator) -> None:
+    u = np.cumsum(rng.standard_normal(3000)) * 0.01
+    y = signal.lfilter([0.0, 0.2], [1.0, -0.8], u) + 1e-3 * rng.standard_normal(3000)
+    fast = clpc.CLPC(3, 60, 12, 0.01).run(u, y, dt=0.001)
+    slow = clpc.CLPC(3, 60, 12, 0.01).run(ex.decimate(u, 10), ex.decimate(y, 10), dt=0.01)
+    np.testing.assert_array_equal(fast.index, slow.index)
+    np.testing.assert_allclose(fast.theta, slow.theta, atol=1e-12)
+
+
+def test_stable_inverse_recovers_a_non_minimum_phase_input(make_model, rng) -> None:
+    den, num = np.array([1.0, -1.5, 0.7]), np.array([0.5, 1.0, 0.3])  # zeros -0.37, -1.63
+    model = make_model(den, num)
+    u = np.r_[np.zeros(5), rng.standard_normal(600)]  # at rest before the record, as assumed
+    y = signal.lfilter(num, den, u)
+    with pytest.raises(clpc.ModelError, match="unstable"):
+        model.infer_input(y)
+    u_hat = ex.stable_inverse(model, y)
+    np.testing.assert_allclose(u_hat[:-40], u[:-40], atol=1e-8)
+
+
+def test_stable_inverse_equals_the_causal_inverse_when_minimum_phase(make_model, rng) -> None:
+    model = make_model(np.array([1.0, -1.2, 0.5]), np.array([1.0, 0.4, 0.1]), intercept=0.3)
+    y = np.cumsum(rng.standard_normal(300))
+    np.testing.assert_allclose(ex.stable_inverse(model, y), model.infer_input(y), atol=1e-10)
+
+
+def test_free_run_reproduces_noise_free_data(make_model, rich_input) -> None:
+    den, num = np.array([1.0, -1.5, 0.7]), np.array([0.5, 1.0, 0.3])
+    model = make_model(den, num)
+    u = rich_input(400)
+    y = signal.lfilter(num, den, u)
+    np.testing.assert_allclose(ex.free_run(model, u, y), y, atol=1e-9)
+
+
+def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> None:
+    u = rich_input(1500)
+    y = siso2.output(u)
+    trace = clpc.CLPC(3, 100, 12, 1.0).run(u, y)
+    for k in (1, 10):
+        res = ex.online_prediction(trace, u, y, k)
+        assert res["fit"] > 100.0 - 1e-6
+        assert 0.95 < res["coverage"] <= 1.0
+
+
+def test_error_profile_on_a_decaying_error() -> None:
+    t = np.arange(500) * 0.01
+    err = np.exp(-t) * np.where(t > 0.2, 1.0, 0.5)
+    prof = ex.error_profile(err, 0.01, corner=0.2)
+    assert prof["rms_last_second"] < prof["rms_first_second"]
+    assert prof["peak_time"] == pytest.approx(0.21)
+    assert len(prof["rms_per_second"]) == 5
+    assert prof["corner_peak"] == pytest.approx(prof["peak"])
+    assert ex.error_profile(np.array([0.0, np.inf]), 0.01) == {"diverged": True}
+
+
+def test_duration_must_cover_the_ramp_and_the_window(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="at least 3 s"):
+        ex.run_experiment(tmp_path, duration=1.0)
