@@ -1,0 +1,6 @@
+"""``python -m clpc``: the same command line as the ``clpc`` console script."""
+
+from clpc.cli import main
+
+if __name__ == "__main__":
+    main()
