@@ -105,7 +105,7 @@ def test_identify_json_matches_library():
     assert s["dt"] == 0.08 and s["structure"] == {"na": 3, "nb": 3, "nk": 0}
 
 
-def test_identify_auto_order_uses_bic(record):
+def test_identify_auto_order(record):
     path, *_ = record
     s = json.loads(
         ok(
@@ -124,11 +124,17 @@ def test_identify_auto_order_uses_bic(record):
             "--json",
         ).output
     )
-    sel = clpc.select_order(clpc.io.load_iodata(path, "u", "y"), orders=range(1, 5))
+    sel = clpc.select_order(
+        clpc.io.load_iodata(path, "u", "y"), orders=range(1, 5), criterion="validation"
+    )
     assert s["order_selection"]["best"] == sel.best == s["structure"]["na"]
     assert s["order_selection"]["orders"] == [1, 2, 3, 4]
+    assert s["order_selection"]["criterion"] == "validation"
     assert s["dt"] == pytest.approx(0.01)
-    assert "order selection (BIC" in ok("identify", path, "-u", "u", "-y", "y", "-n", "auto").output
+    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto").output
+    assert "order selection (held-out 10-step fit %" in out
+    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto", "--criterion", "bic").output
+    assert "order selection (BIC, lower is better)" in out
 
 
 def test_identify_mimo_and_column_indices():

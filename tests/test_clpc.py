@@ -379,3 +379,13 @@ def test_estimates_without_y_are_never_accepted():
     assert weak.any()
     assert not trace.accepted[weak].any()
     assert np.all(np.isfinite(trace.den)) and np.abs(trace.den).max() < 1e3
+
+
+def test_time_uses_the_records_sample_time_without_decimation():
+    u, y = record(400, noise=0.01)
+    trace = CLPC(3, 101, 12).run(clpc.IOData(u, y, dt=0.08))
+    np.testing.assert_allclose(trace.time, trace.index * 0.08)
+    assert trace.sample_time == 0.08
+    model = trace.steady_state_model(allow_unconverged=True)
+    assert model.dt == 0.08
+    assert "no fit statistics" in str(clpc.fit_verdict(model))

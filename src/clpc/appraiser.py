@@ -164,7 +164,12 @@ class CLPC:
         self._dec_phase = 0
         self._pending: list[np.ndarray] = []
         self._empty: Trace | None = None
+        self._record_dt: float | None = None
         return self
+
+    def _time_step(self) -> float:
+        """Seconds per (decimated) sample: sample_time, else the data's, else 1."""
+        return self.sample_time or self._record_dt or self.data_sample_time or 1.0
 
     @property
     def counter(self) -> int:
@@ -358,6 +363,8 @@ class CLPC:
         self.reset()
         self._init_channels(data.n_inputs, data.n_outputs, (data.input_names, data.output_names))
         self._factor = self._decimation_factor(data_dt)
+        if self.sample_time is None and data_dt is not None:
+            self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
         return self.push(data.u, data.y)
 
     # ================================================================= engine
@@ -485,7 +492,7 @@ class CLPC:
         arrays = dict(res)
         arrays.update(theta=theta, c=c_out, accepted=accepted, has_model=has_model,
                       den=den, num=num, stable=stable)
-        dt = self.sample_time or 1.0
+        dt = self._time_step()
         return self._trace(index, index * dt, n_rows, not_enough, arrays)
 
     def _monic(
@@ -526,7 +533,7 @@ class CLPC:
             structure=self.structure,
             n_inputs=self._n_in or 1,
             mode=self._mode() if self._n_in is not None else "siso",
-            sample_time=self.sample_time or 1.0,
+            sample_time=self._time_step(),
             input_names=names[0],
             output_names=names[1],
             meta={"gate": self.gate, "method": self.method},
@@ -603,6 +610,7 @@ class CLPC:
             "factor": self._factor,
             "dec_zi": arr(self._dec_zi),
             "dec_phase": self._dec_phase,
+            "record_dt": self._record_dt,
         }
 
     @classmethod
@@ -631,6 +639,7 @@ class CLPC:
         obj._factor = state["factor"]
         obj._dec_zi = arr(state["dec_zi"])
         obj._dec_phase = int(state["dec_phase"])
+        obj._record_dt = state.get("record_dt")
         return obj
 
     def save(self, path: str) -> None:

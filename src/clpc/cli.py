@@ -261,7 +261,7 @@ def cli() -> None:
     type=_OrderType(),
     default="2",
     show_default=True,
-    help="Model order N (na = nb = N), or 'auto' (BIC over 1..--max-order).",
+    help="Model order N (na = nb = N), or 'auto' (see --criterion, over 1..--max-order).",
 )
 @click.option(
     "--max-order",
@@ -269,6 +269,14 @@ def cli() -> None:
     default=6,
     show_default=True,
     help="Largest order tried by --order auto.",
+)
+@click.option(
+    "--criterion",
+    type=click.Choice(["validation", "bic", "aic", "remark1"]),
+    default="validation",
+    show_default=True,
+    help="How --order auto chooses: held-out 10-step prediction fit on the last third "
+    "(validation), BIC, AIC or the paper's Remark 1.",
 )
 @click.option(
     "--nk", type=click.IntRange(min=0), default=0, show_default=True, help="Input delay in samples."
@@ -295,6 +303,7 @@ def identify(
     outputs: tuple[str, ...],
     order: int | str,
     max_order: int,
+    criterion: str,
     nk: int,
     method: str,
     mimo: str | None,
@@ -320,7 +329,7 @@ def identify(
     selection = None
     if order == "auto":
         selection = select_order(
-            data, orders=range(1, max_order + 1), criterion="bic", estimator=estimator
+            data, orders=range(1, max_order + 1), criterion=criterion, estimator=estimator
         )
         order = selection.best
     model = dataclasses.replace(estimator, order=int(order)).fit(data)
@@ -328,9 +337,10 @@ def identify(
     if selection is not None:
         summary["order_selection"] = jsonable(
             {
-                "criterion": "bic",
+                "criterion": criterion,
                 "orders": selection.orders,
                 "bic": selection.bic,
+                "validation_fit": selection.validation_fit,
                 "best": selection.best,
             }
         )
@@ -341,10 +351,13 @@ def identify(
         _echo_json(summary)
         return
     if selection is not None:
-        bic = ", ".join(
-            f"N={o}: {b:.1f}" for o, b in zip(selection.orders, selection.bic, strict=True)
-        )
-        click.echo(f"order selection (BIC, lower is better): {bic} -> N={selection.best}")
+        if criterion == "validation":
+            values, what = selection.validation_fit, "held-out 10-step fit %, higher is better"
+        else:
+            values = {"bic": selection.bic, "aic": selection.aic, "remark1": selection.J}[criterion]
+            what = f"{criterion.upper()}, lower is better"
+        table = ", ".join(f"N={o}: {v:.1f}" for o, v in zip(selection.orders, values, strict=True))
+        click.echo(f"order selection ({what}): {table} -> N={selection.best}")
     click.echo(format_model_summary(summary))
     if save:
         click.echo(f"model saved to {save}")

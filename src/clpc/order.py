@@ -72,6 +72,7 @@ def select_order(
     dt: float | None = None,
     k: int = 10,
     validation_fraction: float = 1.0 / 3.0,
+    parsimony: float = 1.0,
 ) -> OrderSelection:
     """Choose the model order ``N`` (``na = nb = N``).
 
@@ -97,6 +98,9 @@ def select_order(
         Prediction horizon for ``"validation"``.
     validation_fraction : float
         Share of the record held out for ``"validation"`` (0 < f < 1).
+    parsimony : float
+        ``"validation"`` takes the lowest order whose fit is within this many points of the
+        best (a larger order must earn its parameters).
 
     Returns
     -------
@@ -139,7 +143,7 @@ def select_order(
     val_fit = None
     if criterion == "validation":
         val_fit = _validation_fits(data, base, orders, k, validation_fraction)
-        best = int(orders[np.argmax(val_fit)])
+        best = int(orders[np.flatnonzero(val_fit >= val_fit.max() - parsimony)[0]])
     elif criterion == "aic":
         best = int(orders[np.argmin(aic)])
     elif criterion == "bic":

@@ -51,6 +51,14 @@ class Verdict:
 def fit_verdict(model: Any, output: int = 0) -> Verdict:
     """The verdict of an LPC fit (:meth:`clpc.LPC.fit`) for one output."""
     info = model.info
+    if "n_null" not in info:  # e.g. a CLPC steady-state model: no single fit behind it
+        try:
+            stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
+        except ValueError:
+            stable = False
+        msgs = ("no fit statistics (an averaged or loaded model)",
+                "the model is stable" if stable else "the model is NOT stable")
+        return Verdict(0, True, False, stable, model.structure.nb + 1, msgs)
     n_null = int(np.asarray(info["n_null"])[output])
     n_input = int(np.asarray(info["n_input_relations"])[output])
     determined = bool(np.asarray(info["determined"])[output])
