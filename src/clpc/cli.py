@@ -39,12 +39,11 @@ from .report import (
     model_response,
     model_summary,
     steady_state,
-    trace_columns,
     trace_summary,
     update_records,
     write_track_report,
 )
-from .trace import Trace
+from .tracefile import ThinnedTrace, TraceWriter
 
 __all__ = ["cli", "main"]
 
@@ -495,55 +494,58 @@ def track(
     show = progress if progress is not None else sys.stderr.isatty()
     clock = _Clock(time_col) if time_col else None
     appraiser: CLPC | None = None
-    parts: list[Trace] = []
+    out = Path(out_dir)
+    trace_file = out / f"trace.{fmt}"
+    kept = ThinnedTrace()  # bounded memory whatever the record's length
     n_raw = 0
     names: list[str] = []
-    for chunk_names, values in _record_chunks(file, columns, chunk_rows, show):
-        names = chunk_names
-        if clock is not None:
-            clock.feed(values[:, n_in + n_out])
-            if appraiser is None and clock.dt is None:
-                raise DataError(
-                    f"time column {time_col!r}: the first chunk has one sample; use a larger "
-                    "--chunk-rows or --dt."
+    with TraceWriter(trace_file) as writer:
+        for chunk_names, values in _record_chunks(file, columns, chunk_rows, show):
+            names = chunk_names
+            if clock is not None:
+                clock.feed(values[:, n_in + n_out])
+                if appraiser is None and clock.dt is None:
+                    raise DataError(
+                        f"time column {time_col!r}: the first chunk has one sample; use a "
+                        "larger --chunk-rows or --dt."
+                    )
+            if appraiser is None:
+                data_dt = clock.dt if clock is not None else dt
+                appraiser = CLPC(
+                    parameters_size,
+                    window,
+                    cluster,
+                    sample_time or data_dt,
+                    nk=nk,
+                    data_sample_time=data_dt,
+                    method=method,
+                    gate=gate,
                 )
-        if appraiser is None:
-            data_dt = clock.dt if clock is not None else dt
-            appraiser = CLPC(
-                parameters_size,
-                window,
-                cluster,
-                sample_time or data_dt,
-                nk=nk,
-                data_sample_time=data_dt,
-                method=method,
-                gate=gate,
-            )
-        n_raw += values.shape[0]
-        part = appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
-        if len(part):
-            parts.append(part)
+            n_raw += values.shape[0]
+            part = appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
+            if len(part):
+                part = dataclasses.replace(
+                    part,
+                    input_names=tuple(names[:n_in]),
+                    output_names=tuple(names[n_in : n_in + n_out]),
+                )
+                writer.write(part)
+                kept.add(part)
     assert appraiser is not None  # iter_table_chunks raises on a file without rows
     needed = window + appraiser.structure.max_lag
-    if appraiser.n_samples < needed or not parts:
+    if appraiser.n_samples < needed or not kept.seen:
+        trace_file.unlink(missing_ok=True)
         raise DataError(
             f"the record is too short for the window: {appraiser.n_samples} sample(s) "
             f"(of {n_raw} read) but --window {window} with --parameters-size {parameters_size} "
             f"needs at least {needed}; use a smaller --window or a longer record."
         )
-    trace = dataclasses.replace(
-        Trace.concat(parts),
-        input_names=tuple(names[:n_in]),
-        output_names=tuple(names[n_in : n_in + n_out]),
-    )
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    names, table = trace_columns(trace)
-    trace_file = out / f"trace.{fmt}"
-    write_table(trace_file, names, table)
+    trace = kept.trace()
     settings = {
         "file": file,
         "samples (after decimation)": appraiser.n_samples,
+        "updates": kept.seen,
+        "updates in figures and summary": f"every {kept.stride}" if kept.stride > 1 else "all",
         **appraiser.config(),
     }
     summary = trace_summary(trace)

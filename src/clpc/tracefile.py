@@ -1,0 +1,168 @@
+"""Long CLPC runs in bounded memory: traces written part by part, and a thinned summary.
+
+A record of 1e7 samples gives about 8e5 cluster updates; keeping every row of their trace in
+memory costs about 300 bytes each. :class:`TraceWriter` appends the rows of each part to the
+trace file as they arrive, and :class:`ThinnedTrace` keeps at most ``2 * max_updates`` of them
+for figures and summaries (every update until the cap, then every 2nd, 4th, ... update).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .data import DataError
+from .trace import Trace
+
+__all__ = ["ThinnedTrace", "TraceWriter"]
+
+
+class TraceWriter:
+    """Append trace parts to a CSV or Parquet file (``trace_columns`` layout).
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv`` (floats in their shortest exact form) or ``.parquet`` (needs pyarrow).
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.suffix = self.path.suffix.lower()
+        if self.suffix not in (".csv", ".parquet"):
+            raise DataError(f"trace files are .csv or .parquet; got {self.path.name!r}.")
+        self._fh: Any = None
+        self._writer: Any = None
+        self._names: list[str] | None = None
+        self.rows = 0
+
+    def write(self, part: Trace) -> None:
+        """Append the rows of ``part`` (a trace of consecutive updates)."""
+        from .report import trace_columns  # the one definition of the table layout
+
+        if not len(part):
+            return
+        names, table = trace_columns(part)
+        if self._names is None:
+            self._names = names
+            self._open(names)
+        if self.suffix == ".csv":
+            lines = "\n".join(",".join(map(repr, row)) for row in table.tolist())
+            self._fh.write(lines + "\n")
+        else:
+            import pyarrow as pa
+
+            batch = pa.table({n: table[:, i] for i, n in enumerate(names)})
+            self._writer.write_table(batch)
+        self.rows += table.shape[0]
+
+    def _open(self, names: list[str]) -> None:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        if self.suffix == ".csv":
+            self._fh = self.path.open("w", encoding="utf-8")
+            self._fh.write(",".join(names) + "\n")
+        else:
+            try:
+                import pyarrow as pa
+                import pyarrow.parquet as pq
+            except ImportError:
+                raise ImportError(
+                    "Parquet traces need pyarrow: pip install 'clpc[frames]'"
+                ) from None
+            schema = pa.schema([(n, pa.float64()) for n in names])
+            self._writer = pq.ParquetWriter(self.path, schema)
+
+    def close(self) -> None:
+        """Flush and close the file."""
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
+        if self._writer is not None:
+            self._writer.close()
+            self._writer = None
+
+    def __enter__(self) -> TraceWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class ThinnedTrace:
+    """Keep a bounded, evenly thinned copy of a growing trace.
+
+    Parameters
+    ----------
+    max_updates : int
+        Updates are kept one in ``stride``; when more than ``2 * max_updates`` are held the
+        stride doubles and every other kept update is dropped.
+    """
+
+    def __init__(self, max_updates: int = 20_000) -> None:
+        if max_updates < 1:
+            raise ValueError(f"max_updates must be >= 1; got {max_updates}.")
+        self.max_updates = int(max_updates)
+        self.stride = 1
+        self.seen = 0
+        self._parts: list[Trace] = []
+        self._held = 0
+
+    def add(self, part: Trace) -> None:
+        """Take the updates of ``part`` whose running number is a multiple of ``stride``."""
+        n = len(part)
+        if not n:
+            return
+        numbers = self.seen + np.arange(n)
+        self.seen += n
+        keep = np.flatnonzero(numbers % self.stride == 0)
+        if keep.size:
+            self._parts.append(_take(part, keep))
+            self._held += keep.size
+        while self._held > 2 * self.max_updates:
+            self._thin()
+
+    def _thin(self) -> None:
+        merged = Trace.concat(self._parts)
+        # kept updates are numbered 0, s, 2s, ...: keep the multiples of 2s
+        self.stride *= 2
+        merged = _take(merged, np.arange(0, len(merged), 2))
+        self._parts = [merged]
+        self._held = len(merged)
+
+    def trace(self) -> Trace:
+        """The thinned trace (every ``stride``-th update)."""
+        merged = Trace.concat(self._parts)
+        meta = dict(merged.meta, thinned_stride=self.stride, updates_total=self.seen)
+        return Trace(
+            index=merged.index,
+            time=merged.time,
+            rows=merged.rows,
+            not_enough_data=merged.not_enough_data,
+            arrays=merged.arrays,
+            structure=merged.structure,
+            n_inputs=merged.n_inputs,
+            mode=merged.mode,
+            sample_time=merged.sample_time,
+            input_names=merged.input_names,
+            output_names=merged.output_names,
+            meta=meta,
+        )
+
+
+def _take(trace: Trace, rows: np.ndarray) -> Trace:
+    return Trace(
+        index=trace.index[rows],
+        time=trace.time[rows],
+        rows=trace.rows[rows],
+        not_enough_data=trace.not_enough_data[rows],
+        arrays={k: v[rows] for k, v in trace.arrays.items()},
+        structure=trace.structure,
+        n_inputs=trace.n_inputs,
+        mode=trace.mode,
+        sample_time=trace.sample_time,
+        input_names=trace.input_names,
+        output_names=trace.output_names,
+        meta=trace.meta,
+    )

@@ -1,0 +1,44 @@
+import numpy as np
+import pytest
+
+import clpc
+from clpc import CLPC
+from clpc.io import read_table
+from clpc.report import trace_columns
+from clpc.tracefile import ThinnedTrace, TraceWriter
+
+
+def parts_and_whole():
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(6000)
+    y = clpc.simulate_arx([1, -1.5, 0.7], [0.2, 0.5, 0.1], u) + 0.01 * rng.standard_normal(6000)
+    a = CLPC(3, 101, 12)
+    parts = [a.push(u[i : i + 700], y[i : i + 700]) for i in range(0, 6000, 700)]
+    return parts, CLPC(3, 101, 12).run(u, y)
+
+
+@pytest.mark.parametrize("ext", ["csv", "parquet"])
+def test_writer_appends_exactly_the_whole_trace(tmp_path, ext):
+    parts, whole = parts_and_whole()
+    path = tmp_path / f"trace.{ext}"
+    with TraceWriter(path) as w:
+        for part in parts:
+            w.write(part)
+    table = read_table(path)
+    names, ref = trace_columns(whole)
+    assert table.names == names
+    np.testing.assert_array_equal(table.data, ref)
+
+
+def test_thinned_trace_is_bounded_and_evenly_strided():
+    parts, whole = parts_and_whole()
+    kept = ThinnedTrace(max_updates=40)
+    for part in parts:
+        kept.add(part)
+    thin = kept.trace()
+    assert kept.seen == len(whole)
+    assert len(thin) <= 80 and kept.stride > 1
+    np.testing.assert_array_equal(thin.index, whole.index[:: kept.stride])
+    np.testing.assert_array_equal(thin.theta, whole.theta[:: kept.stride])
+    with pytest.raises(ValueError, match="max_updates"):
+        ThinnedTrace(0)
