@@ -389,3 +389,13 @@ def test_time_uses_the_records_sample_time_without_decimation():
     model = trace.steady_state_model(allow_unconverged=True)
     assert model.dt == 0.08
     assert "no fit statistics" in str(clpc.fit_verdict(model))
+
+
+def test_schur_stability_matches_roots():
+    from clpc.appraiser import schur_stable
+
+    rng = np.random.default_rng(15)
+    dens = np.concatenate([np.ones((2000, 1)), rng.uniform(-2.0, 2.0, (2000, 3))], axis=1)
+    expect = np.array([np.all(np.abs(np.roots(d)) < 1.0) for d in dens])
+    np.testing.assert_array_equal(schur_stable(dens), expect)
+    assert 200 < expect.sum() < 1800  # both outcomes are exercised

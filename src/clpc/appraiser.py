@@ -27,7 +27,6 @@ the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` se
 
 from __future__ import annotations
 
-import itertools
 import json
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict
@@ -165,6 +164,8 @@ class CLPC:
         self._pending: list[np.ndarray] = []
         self._empty: Trace | None = None
         self._record_dt: float | None = None
+        if not hasattr(self, "_pool"):
+            self._pool: ThreadPoolExecutor | None = None
         return self
 
     def _time_step(self) -> float:
@@ -397,11 +398,23 @@ class CLPC:
         trace = self._empty_trace()
         if j_last > self._j_done:
             rows = self._lag_rows(self._buf)  # absolute row index = _buf_start + i
-            parts = []
-            for j0 in range(self._j_done + 1, j_last + 1, _WINDOWS_PER_BATCH):
-                count = min(_WINDOWS_PER_BATCH, j_last + 1 - j0)
-                parts.append(self._updates(rows, j0, count))
-            trace = Trace.concat(parts)
+            batches = [
+                (j0, min(_WINDOWS_PER_BATCH, j_last + 1 - j0))
+                for j0 in range(self._j_done + 1, j_last + 1, _WINDOWS_PER_BATCH)
+            ]
+            # windows are independent: the batches are solved in parallel when asked; the
+            # hold logic of the FSM output then runs in time order
+            if self.n_jobs > 1 and len(batches) > 1:
+                solved = list(
+                    self._executor().map(lambda b: self._solve_windows(rows, *b), batches)
+                )
+            else:
+                solved = [self._solve_windows(rows, *b) for b in batches]
+            parts = [
+                self._finish(res, j0, count, c)
+                for res, (j0, count) in zip(solved, batches, strict=True)
+            ]
+            trace = parts[0] if len(parts) == 1 else Trace.concat(parts)
             self._j_done = j_last
         # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
         keep_row = max(0, c * (self._j_done + 1) - w - c)
@@ -418,21 +431,11 @@ class CLPC:
             self._buf = np.vstack([self._buf, block]) if self._buf.size else block
             self._pending = []
 
-    def _updates(self, rows: np.ndarray, j0: int, count: int) -> Trace:
-        """Solve windows ``j0 .. j0 + count - 1`` (vectorised; threads when n_jobs > 1)."""
-        if self.n_jobs > 1 and count >= 64:
-            bounds = np.linspace(0, count, self.n_jobs + 1).astype(int)
-            with ThreadPoolExecutor(self.n_jobs) as pool:
-                results = list(
-                    pool.map(
-                        lambda ab: self._solve_windows(rows, j0 + ab[0], ab[1] - ab[0]),
-                        [(a, b) for a, b in itertools.pairwise(bounds) if b > a],
-                    )
-                )
-            res = {k: np.concatenate([r[k] for r in results]) for k in results[0]}
-        else:
-            res = self._solve_windows(rows, j0, count)
-        return self._finish(res, j0, count, self.cluster_size)
+    def _executor(self) -> ThreadPoolExecutor:
+        """A thread pool kept for the appraiser's lifetime (created on first use)."""
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(self.n_jobs)
+        return self._pool
 
     def _solve_windows(self, rows: np.ndarray, j0: int, count: int) -> dict[str, np.ndarray]:
         e = rows.shape[0]
@@ -512,12 +515,7 @@ class CLPC:
             for j in range(e):
                 num[:, j, j, s.nk :] = -b[:, j, 0] / a0[:, j, None]
         num[~has_model] = 0.0
-        comp = np.zeros((n, e, s.na, s.na))
-        comp[:, :, 0, :] = -den[:, :, 1:]
-        if s.na > 1:
-            comp[:, :, np.arange(1, s.na), np.arange(s.na - 1)] = 1.0
-        radius = np.abs(np.linalg.eigvals(comp)).max(axis=-1)
-        return den, num, has_model & (radius < 1.0)
+        return den, num, has_model & schur_stable(den)
 
     def _trace(self, index, time, rows, not_enough, arrays) -> Trace:
         names = self._names or (
@@ -659,6 +657,27 @@ class CLPC:
             f"cluster_size={self.cluster_size}, sample_time={self.sample_time}, "
             f"method={self.method!r}, samples_seen={self._n_seen}, updates={self._j_done})"
         )
+
+
+def schur_stable(den: np.ndarray) -> np.ndarray:
+    """Whether every root of ``den[..., 0] z^n + ... + den[..., n]`` lies inside the unit circle.
+
+    The Schur-Cohn (Levinson) recursion, vectorised over the leading axes: with ``a`` the
+    coefficients, for ``m = n .. 1`` the reflection coefficient ``k = a_m / a_0`` must satisfy
+    ``|k| < 1`` and ``a_i <- (a_i - k a_{m-i}) / (1 - k^2)``. Costs ``O(n^2)`` per polynomial
+    instead of an eigenvalue problem of the companion matrix.
+    """
+    a = np.array(den, dtype=np.float64, copy=True)
+    ok = np.ones(a.shape[:-1], dtype=bool)
+    for m in range(a.shape[-1] - 1, 0, -1):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = a[..., m] / a[..., 0]
+        ok &= np.abs(k) < 1.0
+        k = np.where(ok, k, 0.0)
+        rev = a[..., m::-1]
+        a = (a[..., : m + 1] - k[..., None] * rev) / (1.0 - k * k)[..., None]
+        a = a[..., :m]
+    return ok
 
 
 def _positive(value: Any, name: str) -> float:
