@@ -92,3 +92,12 @@ def test_scaling_u_scales_the_numerator_only_for_robust():
     scaled = LPC(order=2).fit(1000.0 * u, y)
     np.testing.assert_allclose(scaled.num, base.num / 1000.0, rtol=1e-9)
     np.testing.assert_allclose(scaled.den, base.den, rtol=1e-9)
+
+
+def test_model_carries_its_verdict():
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal(3000)
+    y = clpc.simulate_arx(DEN, NUM, u) + 0.01 * rng.standard_normal(3000)
+    model = LPC(order=2).fit(u, y)
+    assert model.verdict().determined
+    assert "the data determine the parameters" in str(model.verdict())

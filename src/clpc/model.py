@@ -212,6 +212,12 @@ class LinearModel:
         )
         return w, h
 
+    def verdict(self, output: int = 0) -> Any:
+        """Identifiability of the fit in plain words (:func:`clpc.verdict.fit_verdict`)."""
+        from .verdict import fit_verdict
+
+        return fit_verdict(self, output)
+
     # ----------------------------------------------------------------- time domain
     def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
         """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
