@@ -165,3 +165,16 @@ def test_validation_criterion_picks_the_predictive_order():
     assert sel.best >= 3
     with pytest.raises(ValueError, match="validation_fraction"):
         clpc.select_order(u, y, criterion="validation", validation_fraction=1.5)
+
+
+def test_select_delay_finds_the_dead_time():
+    rng = np.random.default_rng(22)
+    u = rng.standard_normal(6000)
+    y = clpc.simulate_arx([1.0, -1.2, 0.5], [0, 0, 0, 0.4, 0.3], u) + 0.02 * rng.standard_normal(
+        6000
+    )
+    sel = clpc.select_delay(u, y, delays=range(0, 6), estimator=LPC(na=2, nb=1))
+    assert sel.best == 3
+    assert sel.validation_fit[3] > sel.validation_fit[0] + 10.0
+    with pytest.raises(ValueError, match="delays must be ints >= 0"):
+        clpc.select_delay(u, y, delays=[-1])

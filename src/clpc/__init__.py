@@ -15,7 +15,7 @@ from .metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
 from .model import LinearModel, ModelError
 from .model_io import load_model, save_model
 from .noise import NoiseEstimate, estimate_noise_variances
-from .order import OrderSelection, select_order
+from .order import DelaySelection, OrderSelection, select_delay, select_order
 from .regressors import Structure
 from .solve import RobustRule
 from .trace import Convergence, Trace
@@ -29,6 +29,7 @@ __all__ = [
     "LPC",
     "Convergence",
     "DataError",
+    "DelaySelection",
     "IOData",
     "LinearModel",
     "ModelError",
@@ -50,6 +51,7 @@ __all__ = [
     "read_table",
     "rmse",
     "save_model",
+    "select_delay",
     "select_order",
     "simulate_arx",
     "vaf",

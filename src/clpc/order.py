@@ -14,7 +14,7 @@ import numpy as np
 from .data import as_iodata
 from .lpc import LPC
 
-__all__ = ["OrderSelection", "select_order"]
+__all__ = ["DelaySelection", "OrderSelection", "select_delay", "select_order"]
 
 
 @dataclass(frozen=True)
@@ -176,3 +176,63 @@ def _validation_fits(
         ok = np.isfinite(err) and ref > 0
         fits.append(100.0 * (1.0 - err / ref) if ok else -np.inf)
     return np.array(fits)
+
+
+@dataclass(frozen=True)
+class DelaySelection:
+    """Held-out ``k``-step fit % per input delay and the chosen delay."""
+
+    delays: np.ndarray
+    validation_fit: np.ndarray
+    best: int
+
+
+def select_delay(
+    u: Any,
+    y: Any | None = None,
+    *,
+    delays: Any = range(0, 5),
+    estimator: LPC | None = None,
+    dt: float | None = None,
+    k: int = 10,
+    validation_fraction: float = 1.0 / 3.0,
+    parsimony: float = 1.0,
+) -> DelaySelection:
+    """Choose the input delay ``nk`` by held-out ``k``-step prediction fit.
+
+    Parameters
+    ----------
+    u, y, dt
+        The record.
+    delays : iterable of int
+        Candidate delays (>= 0).
+    estimator : LPC, optional
+        Settings (order, method...); its ``nk`` is replaced.
+    k, validation_fraction, parsimony
+        As for :func:`select_order`: the smallest delay whose fit is within ``parsimony``
+        points of the best wins.
+
+    Returns
+    -------
+    DelaySelection
+    """
+    cands = np.array(sorted({int(d) for d in delays}))
+    if cands.size == 0 or cands[0] < 0:
+        raise ValueError(f"delays must be ints >= 0; got {cands.tolist()}.")
+    if not 0.0 < validation_fraction < 1.0:
+        raise ValueError(f"validation_fraction must be in (0, 1); got {validation_fraction!r}.")
+    data = as_iodata(u, y, dt)
+    base = estimator or LPC()
+    split = round(data.n_samples * (1.0 - validation_fraction))
+    est, val = data[:split], data[split:]
+    fits = []
+    for nk in cands:
+        model = replace(base, nk=int(nk)).fit(est)
+        y_hat = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
+        start = replace(base, nk=int(cands[-1])).structure().max_lag
+        err = np.linalg.norm(val.y[start:] - y_hat[start:])
+        ref = np.linalg.norm(val.y[start:] - val.y[start:].mean(axis=0))
+        fits.append(100.0 * (1.0 - err / ref) if np.isfinite(err) and ref > 0 else -np.inf)
+    fit = np.array(fits)
+    best = int(cands[np.flatnonzero(fit >= fit.max() - parsimony)[0]])
+    return DelaySelection(cands, fit, best)
