@@ -398,9 +398,14 @@ class CLPC:
         trace = self._empty_trace()
         if j_last > self._j_done:
             rows = self._lag_rows(self._buf)  # absolute row index = _buf_start + i
+            n_new = j_last - self._j_done
+            n_batches = -(-n_new // _WINDOWS_PER_BATCH)
+            if self.n_jobs > 1:  # equal shares for the threads
+                n_batches = -(-n_batches // self.n_jobs) * self.n_jobs
+            size = -(-n_new // n_batches)
             batches = [
-                (j0, min(_WINDOWS_PER_BATCH, j_last + 1 - j0))
-                for j0 in range(self._j_done + 1, j_last + 1, _WINDOWS_PER_BATCH)
+                (j0, min(size, j_last + 1 - j0))
+                for j0 in range(self._j_done + 1, j_last + 1, size)
             ]
             # windows are independent: the batches are solved in parallel when asked; the
             # hold logic of the FSM output then runs in time order
