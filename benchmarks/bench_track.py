@@ -41,9 +41,26 @@ def run_track(path: str, out: str) -> tuple[float, float]:
     """Wall seconds and peak RSS [MiB] of one `clpc track` subprocess."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     t0 = time.perf_counter()
-    cmd = [sys.executable, "-m", "clpc", "track", path, "-u", "u", "-y", "y",
-           "--parameters-size", "3", "--window", "201", "--cluster", "12",
-           "--out", out, "--no-progress"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "clpc",
+        "track",
+        path,
+        "-u",
+        "u",
+        "-y",
+        "y",
+        "--parameters-size",
+        "3",
+        "--window",
+        "201",
+        "--cluster",
+        "12",
+        "--out",
+        out,
+        "--no-progress",
+    ]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     wall = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
