@@ -334,9 +334,9 @@ class CLPC:
         if self._factor is None:
             self._factor = self._decimation_factor(None)
         parts = []
-        raw = np.hstack([u2, y2])
-        for lo in range(0, raw.shape[0], self.chunk_samples):
-            trace = self._consume(self._decimate(raw[lo : lo + self.chunk_samples]))
+        for lo in range(0, u2.shape[0], self.chunk_samples):  # bounded working memory
+            hi = lo + self.chunk_samples
+            trace = self._consume(self._decimate(np.hstack([u2[lo:hi], y2[lo:hi]])))
             if len(trace):
                 parts.append(trace)
         if not parts:

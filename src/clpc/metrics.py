@@ -81,14 +81,17 @@ def vaf(y: Any, y_hat: Any) -> Any:
 
 
 def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
-    """Fit % of the ``k``-step-ahead prediction (skips the first ``max_lag`` samples).
+    """Fit % of the ``k``-step-ahead prediction (skips the first ``max_lag + k - 1`` samples).
 
     For integrating plants (a motor from torque to position) a free-run simulation drifts
     and says little; the ``k``-step fit measures what the model knows about the dynamics.
     """
     y_arr = np.asarray(y, dtype=np.float64)
     y_hat = model.predict(u, y_arr, k=k)
-    start = model.structure.max_lag
+    # the first k - 1 predictions after max_lag still lean on measured outputs newer than
+    # n - k (the record has no earlier past): skip them so every scored sample is a true
+    # k-step prediction
+    start = model.structure.max_lag + k - 1
     return fit_percent(y_arr[start:], y_hat[start:])
 
 

@@ -292,7 +292,9 @@ class LinearModel:
 
         Each prediction uses measured outputs up to ``n - k`` and the model for the rest
         (for ``k = 1`` the one-step-ahead predictor of the equation). The first
-        ``max_lag`` samples have no complete past and are returned as measured.
+        ``max_lag`` samples have no complete past and are returned as measured; the next
+        ``k - 1`` can only use the measured start of the record, so they are predictions
+        over fewer than ``k`` steps (:func:`clpc.kstep_fit` skips them).
 
         Parameters
         ----------

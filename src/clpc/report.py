@@ -122,6 +122,7 @@ def model_response(
             y_hat[start:] = model.simulate(u2[start:], y_init=y2[:start], u_init=u2[:start])
     else:
         y_hat = np.asarray(model.predict(u2, y2, k=k)).reshape(y2.shape)
+        start += k - 1  # only true k-step predictions are scored (as clpc.kstep_fit)
     fit = np.full(y2.shape[1], np.nan)
     for j in range(y2.shape[1]):  # per output: one diverging output leaves the others' fit
         if np.all(np.isfinite(y_hat[start:, j])):
