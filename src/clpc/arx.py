@@ -39,13 +39,7 @@ class ARX:
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
-        if self.na is None and self.nb is None:
-            return Structure.from_order(self.order, self.nk)
-        return Structure(
-            self.order if self.na is None else self.na,
-            self.order if self.nb is None else self.nb,
-            self.nk,
-        )
+        return Structure.from_settings(self.order, self.na, self.nb, self.nk)
 
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
         """Least-squares fit; returns a :class:`LinearModel` (``theta`` unit norm, a0 > 0)."""

@@ -156,13 +156,7 @@ class LPC:
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
-        if self.na is None and self.nb is None:
-            return Structure.from_order(self.order, self.nk)
-        return Structure(
-            self.order if self.na is None else self.na,
-            self.order if self.nb is None else self.nb,
-            self.nk,
-        )
+        return Structure.from_settings(self.order, self.na, self.nb, self.nk)
 
     def _noise_cov(self, structure: Structure, n_blocks: int) -> np.ndarray | None:
         if self.noise_cov is not None:

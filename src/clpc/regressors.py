@@ -70,6 +70,15 @@ class Structure:
         order = _check_int(order, "order", 1)
         return cls(order, order, nk)
 
+    @classmethod
+    def from_settings(
+        cls, order: int, na: int | None = None, nb: int | None = None, nk: int = 0
+    ) -> Structure:
+        """``na = nb = order`` unless ``na``/``nb`` are given (estimator settings)."""
+        if na is None and nb is None:
+            return cls.from_order(order, nk)
+        return cls(order if na is None else na, order if nb is None else nb, nk)
+
     @property
     def max_lag(self) -> int:
         """Largest lag used: the first sample index with a complete lag vector."""

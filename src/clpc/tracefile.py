@@ -8,6 +8,7 @@ for figures and summaries (every update until the cap, then every 2nd, 4th, ... 
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -135,34 +136,15 @@ class ThinnedTrace:
         """The thinned trace (every ``stride``-th update)."""
         merged = Trace.concat(self._parts)
         meta = dict(merged.meta, thinned_stride=self.stride, updates_total=self.seen)
-        return Trace(
-            index=merged.index,
-            time=merged.time,
-            rows=merged.rows,
-            not_enough_data=merged.not_enough_data,
-            arrays=merged.arrays,
-            structure=merged.structure,
-            n_inputs=merged.n_inputs,
-            mode=merged.mode,
-            sample_time=merged.sample_time,
-            input_names=merged.input_names,
-            output_names=merged.output_names,
-            meta=meta,
-        )
+        return replace(merged, meta=meta)
 
 
 def _take(trace: Trace, rows: np.ndarray) -> Trace:
-    return Trace(
+    return replace(
+        trace,
         index=trace.index[rows],
         time=trace.time[rows],
         rows=trace.rows[rows],
         not_enough_data=trace.not_enough_data[rows],
         arrays={k: v[rows] for k, v in trace.arrays.items()},
-        structure=trace.structure,
-        n_inputs=trace.n_inputs,
-        mode=trace.mode,
-        sample_time=trace.sample_time,
-        input_names=trace.input_names,
-        output_names=trace.output_names,
-        meta=trace.meta,
     )
