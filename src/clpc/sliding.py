@@ -26,6 +26,10 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 __all__ = ["block_stats", "window_scatter"]
 
+# with more pieces than this per window (small clusters, e.g. an update every sample) the
+# windows come from prefix sums re-centered on each batch of windows instead of merged blocks
+_PREFIX_ABOVE_PIECES = 32
+
 
 def block_stats(rows: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     """Mean and centered scatter of consecutive blocks of rows.
@@ -76,6 +80,8 @@ def window_scatter(
     """
     e, n, p = rows.shape
     q, r = divmod(window, cluster)
+    if q > _PREFIX_ABOVE_PIECES:
+        return _prefix_windows(rows, first_row, first_window, n_windows, window, cluster)
     j0, j1 = first_window, first_window + n_windows
     lo_block = max(j0 - q - (1 if r else 0), 0)
     start = lo_block * cluster - first_row
@@ -156,3 +162,36 @@ def _merge_slices(
         dev = means[:, first + o : first + o + count] - mean
         scatter = scatter + size * (dev[..., :, None] * dev[..., None, :])
     return scatter, mean, np.full(count, int(n_rows), dtype=np.int64)
+
+
+def _prefix_windows(
+    rows: np.ndarray, first_row: int, first_window: int, n_windows: int, window: int, cluster: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Windows from prefix sums of the rows re-centered on the batch's own mean.
+
+    ``A = S2 - S1 S1^T / n`` with ``S1``, ``S2`` the sums of ``z - shift`` and of its outer
+    products over the window. The shift is the mean of the rows the batch spans, so the
+    cancellation costs about ``eps (spread of the batch / spread of a window)^2`` - the
+    periodic re-centering that keeps long records and large offsets exact to ~1e-12, at
+    ``O(p^2)`` per window whatever the cluster size (for small clusters, where merging
+    ``W / C`` blocks would cost ``O(W p^2 / C)``).
+    """
+    e, n, p = rows.shape
+    ends = (first_window + np.arange(n_windows)) * cluster  # exclusive, absolute
+    starts = np.maximum(ends - window, 0)
+    lo, hi = int(starts[0]), int(ends[-1])
+    span = rows[:, lo - first_row : hi - first_row]
+    shift = span.mean(axis=1, keepdims=True)
+    z = span - shift
+    c1 = np.zeros((e, z.shape[1] + 1, p))
+    np.cumsum(z, axis=1, out=c1[:, 1:])
+    c2 = np.zeros((e, z.shape[1] + 1, p, p))
+    np.cumsum(z[..., :, None] * z[..., None, :], axis=1, out=c2[:, 1:])
+    a, b = starts - lo, ends - lo
+    n_rows = (ends - starts).astype(np.float64)
+    s1 = c1[:, b] - c1[:, a]
+    s2 = c2[:, b] - c2[:, a]
+    mean_dev = s1 / n_rows[None, :, None]
+    scatter = s2 - s1[..., :, None] * mean_dev[..., None, :]
+    scatter = 0.5 * (scatter + np.swapaxes(scatter, -1, -2))
+    return scatter, shift + mean_dev, (ends - starts).astype(np.int64)
