@@ -407,7 +407,7 @@ def test_small_clusters_prefix_path_is_exact_and_streams(cluster):
     u, y = record(3000, seed=16, noise=0.05, offset=1e4)
     trace = CLPC(3, 201, cluster, method="paper").run(u, y)
     for t in range(12, len(trace), 97):  # windows with at least 12 rows (full spectrum)
-        scatter, vals, vecs = exact_window(u, y, (t + 1) * cluster, 201)
+        _scatter, vals, vecs = exact_window(u, y, (t + 1) * cluster, 201)
         np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
         if vals[0] < 0.1 * vals[1]:
             ref = vecs[0] * np.sign(vecs[0][0])

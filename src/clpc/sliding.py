@@ -176,7 +176,7 @@ def _prefix_windows(
     ``O(p^2)`` per window whatever the cluster size (for small clusters, where merging
     ``W / C`` blocks would cost ``O(W p^2 / C)``).
     """
-    e, n, p = rows.shape
+    e, _n, p = rows.shape
     ends = (first_window + np.arange(n_windows)) * cluster  # exclusive, absolute
     starts = np.maximum(ends - window, 0)
     lo, hi = int(starts[0]), int(ends[-1])
