@@ -494,21 +494,7 @@ class _TextReader:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "input contained no data"
-                if self.full:
-                    arr = np.loadtxt(
-                        lines,
-                        dtype=np.float64,
-                        delimiter=fmt.delimiter,
-                        comments="#",
-                        quotechar='"',
-                        ndmin=2,
-                    )
-                    if arr.shape[0] == 0:
-                        return np.empty((0, fmt.n_cols))
-                    if arr.shape[1] != fmt.n_cols:
-                        return None
-                    return arr
-                if not self._field_counts_ok(lines):
+                if not self.full and not self._field_counts_ok(lines):
                     return None
                 arr = np.loadtxt(
                     lines,
@@ -517,10 +503,13 @@ class _TextReader:
                     comments="#",
                     quotechar='"',
                     ndmin=2,
-                    usecols=self.use,
+                    usecols=None if self.full else self.use,
                 )
+                n_cols = fmt.n_cols if self.full else len(self.use)
                 if arr.shape[0] == 0:
-                    return np.empty((0, len(self.use)))
+                    return np.empty((0, n_cols))
+                if arr.shape[1] != n_cols:
+                    return None
                 return arr
         except ValueError:
             return None

@@ -28,7 +28,7 @@ import numpy as np
 from .data import IOData
 from .metrics import fit_percent
 from .model import LinearModel
-from .trace import Trace
+from .trace import SCALAR_KEYS, Trace
 from .verdict import describe_trace, fit_verdict
 
 __all__ = [
@@ -272,23 +272,6 @@ def _fmt_complex(re: float, im: float) -> str:
 
 
 # ===================================================================== traces
-_TRACE_SCALARS = (
-    "D",
-    "lambda_min",
-    "lambda_max",
-    "eig_ratio",
-    "separation",
-    "noise_variance",
-    "J",
-    "c",
-    "n_null",
-    "n_input_relations",
-    "degenerate",
-    "determined",
-    "accepted",
-    "has_model",
-    "stable",
-)
 
 
 def update_records(trace: Trace) -> list[dict[str, Any]]:
@@ -311,7 +294,7 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
             "rows": int(trace.rows[i]),
             "not_enough_data": bool(trace.not_enough_data[i]),
         }
-        for key in ("theta", "den", "num", *_TRACE_SCALARS):
+        for key in ("theta", "den", "num", *SCALAR_KEYS):
             val = a[key][i]
             if key == "num" and single and trace.n_inputs == 1:
                 val = val[:, 0]
@@ -346,7 +329,7 @@ def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
             for i in range(a["num"].shape[3]):
                 names.append(f"{pre}num{i}{suffix}")
                 cols.append(a["num"][:, e, u, i])
-        for key in _TRACE_SCALARS:
+        for key in SCALAR_KEYS:
             names.append(pre + key)
             cols.append(a[key][:, e])
     table = (

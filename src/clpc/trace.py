@@ -12,16 +12,11 @@ from .regressors import Structure
 
 __all__ = ["Convergence", "Trace"]
 
-# per-update arrays; axis 1 (when present) is the equation (output) axis
-_PER_EQUATION = (
-    "theta",
-    "theta_estimate",
-    "den",
-    "num",
-    "eigenvalues",
+# per-update scalar statistics of each equation: shape (n_updates, n_equations)
+SCALAR_KEYS = (
+    "D",
     "lambda_min",
     "lambda_max",
-    "D",
     "eig_ratio",
     "separation",
     "a0_weight",
@@ -36,6 +31,8 @@ _PER_EQUATION = (
     "has_model",
     "stable",
 )
+# every per-update array; axis 1 (when present) is the equation (output) axis
+_PER_EQUATION = ("theta", "theta_estimate", "den", "num", "eigenvalues", *SCALAR_KEYS)
 
 
 @dataclass(frozen=True)
@@ -171,9 +168,7 @@ class Trace:
             pre = f"{self.output_names[e]}:" if self.n_equations > 1 else ""
             for i, lab in enumerate(labels):
                 cols[pre + lab] = self.arrays["theta"][:, e, i]
-            for key in ("lambda_min", "lambda_max", "D", "eig_ratio", "separation",
-                        "noise_variance", "J", "c", "n_null", "n_input_relations",
-                        "degenerate", "determined", "accepted", "has_model", "stable"):
+            for key in SCALAR_KEYS:
                 cols[pre + key] = self.arrays[key][:, e]
         return pd.DataFrame(cols)
 
