@@ -1,4 +1,8 @@
-"""The CLPC appraiser: semantics, streaming == batch, persistence, exactness, tracking."""
+"""The CLPC appraiser: semantics, streaming == batch, persistence, exactness, tracking.
+
+Every test runs on both engines (the compiled kernel and the numpy/LAPACK one), selected
+through ``CLPC_ENGINE`` as a user would.
+"""
 
 from __future__ import annotations
 
@@ -7,7 +11,7 @@ import json
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
@@ -16,6 +20,13 @@ from clpc import CLPC, DataError, Trace
 
 DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.2, 0.5, 0.1])
+
+
+@pytest.fixture(autouse=True, params=["compiled", "numpy"])
+def engine(request, monkeypatch):
+    monkeypatch.setenv("CLPC_ENGINE", request.param)
+    assert CLPC().engine == request.param
+    return request.param
 
 
 def record(n: int, seed: int = 0, noise: float = 0.0, offset: float = 0.0):
@@ -116,7 +127,9 @@ def test_unconverged_steady_state_raises():
 
 
 # ---------------------------------------------------------------- streaming == batch
-@settings(max_examples=15, deadline=None)
+@settings(
+    max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(st.lists(st.integers(min_value=1, max_value=300), min_size=1, max_size=40))
 def test_push_any_chunking_equals_run(chunks):
     u, y = record(2500, seed=1, noise=0.01)

@@ -83,15 +83,33 @@ def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str
     ``log_likelihood``, ``J`` (eq. 22), ``n_rows``, ``n_null``, ``n_input_relations``,
     ``degenerate``, ``determined``.
     """
-    vals = res.eigenvalues
-    lam_min, lam_max = vals[:, 0], vals[:, -1]
+    return solution_info(
+        res.eigenvalues, res.c, res.noise_variance, res.n_null, res.n_input_relations,
+        res.separation, res.degenerate, n_rows, rule,
+    )
+
+
+def solution_info(
+    eigenvalues: np.ndarray,
+    c: np.ndarray,
+    noise_variance: np.ndarray,
+    n_null: np.ndarray,
+    n_input_relations: np.ndarray,
+    separation: np.ndarray,
+    degenerate: np.ndarray,
+    n_rows: np.ndarray,
+    rule: RobustRule,
+) -> dict[str, np.ndarray]:
+    """:func:`fit_info` from the solution's arrays (any leading shape ``s``).
+
+    ``eigenvalues`` has shape ``s + (p,)``, the others ``s`` (``n_rows`` broadcasts).
+    """
+    vals = eigenvalues
+    lam_min, lam_max = vals[..., 0], vals[..., -1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(lam_max > 0, lam_min / np.where(lam_max > 0, lam_max, 1.0), 1.0)
     determined = (
-        (res.n_null == 1)
-        & (res.n_input_relations == 0)
-        & (res.separation <= rule.separation)
-        & ~res.degenerate
+        (n_null == 1) & (n_input_relations == 0) & (separation <= rule.separation) & ~degenerate
     )
     return {
         "eigenvalues": vals,
@@ -99,15 +117,15 @@ def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str
         "lambda_max": lam_max,
         "D": lam_max - lam_min,
         "eig_ratio": ratio,
-        "separation": res.separation,
-        "c": res.c,
-        "noise_variance": res.noise_variance,
-        "log_likelihood": log_likelihood(res.noise_variance, n_rows),
-        "J": index_j(res.noise_variance, n_rows),
+        "separation": separation,
+        "c": c,
+        "noise_variance": noise_variance,
+        "log_likelihood": log_likelihood(noise_variance, n_rows),
+        "J": index_j(noise_variance, n_rows),
         "n_rows": np.asarray(n_rows),
-        "n_null": res.n_null,
-        "n_input_relations": res.n_input_relations,
-        "degenerate": res.degenerate,
+        "n_null": n_null,
+        "n_input_relations": n_input_relations,
+        "degenerate": degenerate,
         "determined": determined,
     }
 

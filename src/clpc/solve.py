@@ -267,6 +267,19 @@ def _whitening(
             return None
         scales = channel_scales(scatter, n_rows, blocks)
         return np.einsum("kp,pq->kpq", 1.0 / scales, np.eye(p))
+    return np.broadcast_to(fixed_transform(noise_cov, p), (k, p, p))
+
+
+def fixed_transform(noise_cov: np.ndarray, p: int) -> np.ndarray:
+    """Whitening ``T`` (shape (p, p)) with ``T^T W T = I`` for a known noise covariance ``W``.
+
+    Parameters
+    ----------
+    noise_cov : array_like, shape (p,) or (p, p)
+        Variances (diagonal ``W``) or the full covariance of the lag-vector noise.
+    p : int
+        Lag-vector length.
+    """
     cov = np.asarray(noise_cov, dtype=np.float64)
     if cov.shape == (p,):
         if np.any(~np.isfinite(cov)) or np.any(cov <= 0):
@@ -274,7 +287,7 @@ def _whitening(
                 "noise_cov must hold positive finite variances, one per lag-vector entry; "
                 f"got {cov.tolist()}."
             )
-        return np.broadcast_to(np.diag(1.0 / np.sqrt(cov)), (k, p, p))
+        return np.diag(1.0 / np.sqrt(cov))
     if cov.shape != (p, p):
         raise ValueError(
             f"noise_cov must have shape ({p},) (variances) or ({p}, {p}) (covariance), one "
@@ -287,7 +300,7 @@ def _whitening(
     except np.linalg.LinAlgError:
         raise ValueError("noise_cov must be positive definite.") from None
     # T = L^{-T}: then T^T W T = L^{-1} L L^T L^{-T} = I
-    return np.broadcast_to(np.linalg.inv(chol).T, (k, p, p))
+    return np.linalg.inv(chol).T
 
 
 def _decompose(
