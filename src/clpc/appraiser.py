@@ -387,20 +387,31 @@ class CLPC:
                 f"u and y must have the same length; got len(u)={u2.shape[0]}, "
                 f"len(y)={y2.shape[0]}."
             )
-        _check_finite(u2, "u", self._n_seen)
-        _check_finite(y2, "y", self._n_seen)
+        for lo in range(0, u2.shape[0], 1 << 20):  # bounded temporaries
+            _check_finite(u2[lo : lo + (1 << 20)], "u", self._n_seen + lo)
+            _check_finite(y2[lo : lo + (1 << 20)], "y", self._n_seen + lo)
         self._init_channels(u2.shape[1], y2.shape[1])
         if self._factor is None:
             self._factor = self._decimation_factor(None)
-        parts = []
+        total = self._updates_after(u2.shape[0])
+        # the parts are written into the final arrays (no concatenation at the end)
+        out = Trace.allocate(self._empty_trace(), total) if total else self._empty_trace()
+        done = 0
         for lo in range(0, u2.shape[0], self.chunk_samples):  # bounded working memory
             hi = lo + self.chunk_samples
-            trace = self._consume(self._decimate(np.hstack([u2[lo:hi], y2[lo:hi]])))
-            if len(trace):
-                parts.append(trace)
-        if not parts:
-            return self._empty_trace()
-        return parts[0] if len(parts) == 1 else Trace.concat(parts)
+            part = self._consume(self._decimate(np.hstack([u2[lo:hi], y2[lo:hi]])))
+            if total:
+                done = out.put(done, part)
+        assert done == total, (done, total)
+        return out
+
+    def _updates_after(self, n_samples: int) -> int:
+        """Updates that ``n_samples`` more (undecimated) samples will complete."""
+        f = self._factor or 1
+        first = (-self._dec_phase) % f  # the first of them that decimation keeps
+        kept = 0 if first >= n_samples else (n_samples - 1 - first) // f + 1
+        rows = max(self._n_seen + kept - self._max_lag, 0)
+        return rows // self.cluster_size - self._j_done
 
     def run(self, u: Any, y: Any | None = None, dt: float | None = None) -> Trace:
         """Reset, then process a whole record (vectorised over windows).
@@ -417,15 +428,24 @@ class CLPC:
         Trace
             One row per update.
         """
-        data = as_iodata(u, y, dt)
-        given_dt = isinstance(u, IOData) or dt is not None
-        data_dt = data.dt if given_dt else None  # arrays without dt: already at sample_time
         self.reset()
-        self._init_channels(data.n_inputs, data.n_outputs, (data.input_names, data.output_names))
+        if isinstance(u, np.ndarray) and isinstance(y, np.ndarray):
+            # plain arrays: validated by push, without IOData's defensive copy of the record
+            u_arr, y_arr = _as_columns(u, "u"), _as_columns(y, "y")
+            data_dt = None if dt is None else _positive(dt, "dt")
+            self._init_channels(u_arr.shape[1], y_arr.shape[1])
+        else:
+            data = as_iodata(u, y, dt)
+            u_arr, y_arr = data.u, data.y
+            given_dt = isinstance(u, IOData) or dt is not None
+            data_dt = data.dt if given_dt else None  # arrays without dt: at sample_time
+            self._init_channels(
+                data.n_inputs, data.n_outputs, (data.input_names, data.output_names)
+            )
         self._factor = self._decimation_factor(data_dt)
         if self.sample_time is None and data_dt is not None:
             self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        return self.push(data.u, data.y)
+        return self.push(u_arr, y_arr)
 
     # ================================================================= engine
     def _lag_rows(self, buf: np.ndarray) -> np.ndarray:

@@ -142,6 +142,32 @@ class Trace:
         }
         return cls(**kw, arrays=arrays, **rest)
 
+    @classmethod
+    def allocate(cls, like: Trace, n: int) -> Trace:
+        """An uninitialised trace of ``n`` rows shaped like ``like`` (fill it with :meth:`put`).
+
+        Lets a long run write its parts into the final arrays instead of concatenating them
+        at the end (which holds the parts and the result at once: twice the memory).
+        """
+        plain = ("index", "time", "rows", "not_enough_data")
+        kw = {f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in plain}
+        arrays = {k: np.empty((n, *v.shape[1:]), v.dtype) for k, v in like.arrays.items()}
+        rest = {
+            f.name: getattr(like, f.name)
+            for f in fields(cls)
+            if f.name not in plain and f.name != "arrays"
+        }
+        return cls(**kw, arrays=arrays, **rest)
+
+    def put(self, start: int, part: Trace) -> int:
+        """Copy the rows of ``part`` into rows ``start ..``; returns the row after them."""
+        stop = start + len(part)
+        for f in ("index", "time", "rows", "not_enough_data"):
+            getattr(self, f)[start:stop] = getattr(part, f)
+        for key, value in self.arrays.items():
+            value[start:stop] = part.arrays[key]
+        return stop
+
     # ----------------------------------------------------------------- views
     def labels(self) -> list[str]:
         """Names of the entries of ``theta``: ``a0 .. a_na, b0 .. b_nb`` per input block."""
