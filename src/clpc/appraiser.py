@@ -125,7 +125,7 @@ class CLPC:
         Samples processed at a time by :meth:`push` (bounds memory).
     engine : {"auto", "compiled", "numpy"}
         ``"compiled"``: the numba kernel of :mod:`clpc.window_kernel` (needs numba, the
-        ``fast`` extra; 2-4x faster in batch, ~20x in :meth:`step`); ``"numpy"``: the
+        ``fast`` extra; about 2x faster in batch, 10x in :meth:`step`); ``"numpy"``: the
         vectorised numpy/LAPACK engine; ``"auto"`` (default): compiled when numba is
         installed (the environment variable ``CLPC_ENGINE`` overrides ``"auto"``). Both
         give the same numbers to ~1e-12, not bit for bit.

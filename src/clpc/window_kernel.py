@@ -4,8 +4,8 @@ The numpy engine (:mod:`clpc.sliding` + :func:`clpc.solve.solve_scatter`) is vec
 windows but pays a LAPACK call (~4 us) per 6x6 matrix, two of them with the robust default,
 plus numpy's per-call overhead on small arrays. This module does the same computation for
 one window after the other inside numba-compiled loops (:mod:`clpc.small_eigh` for the
-eigenproblems), with no temporaries: about 10-20x the plain per-window reference instead of
-~5x (``benchmarks/bench_clpc.py``). It is used when numba is installed (``CLPC(engine=...)``).
+eigenproblems), with no temporaries: about 9-10x the plain per-window reference instead of
+~4.5x (``benchmarks/bench_clpc.py``). It is used when numba is installed (``CLPC(engine=...)``).
 
 The arithmetic is the numpy engine's, not its bit pattern (different eigen-solver, merge
 order): the two agree to ~1e-12 (``tests/test_window_kernel.py``). Within this engine, a
