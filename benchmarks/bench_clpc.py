@@ -82,27 +82,9 @@ SEED = 20240607
 
 
 # ====================================================================== data
-def generate(path_u: Path, path_y: Path, n: int, block: int = 1_000_000) -> None:
-    """Write ``n`` samples of u and y (float64, raw binary) block by block."""
-    rng = np.random.default_rng(SEED)
-    zi_u = np.zeros(len(DEN) - 1)
-    zi_e = np.zeros(len(DEN) - 1)
-    with open(path_u, "wb") as fu, open(path_y, "wb") as fy:
-        for lo in range(0, n, block):
-            m = min(block, n - lo)
-            u = rng.standard_normal(m)
-            e = EQ_NOISE * rng.standard_normal(m)
-            yu, zi_u = signal.lfilter(NUM, DEN, u, zi=zi_u)
-            ye, zi_e = signal.lfilter([1.0], DEN, e, zi=zi_e)
-            y = yu + ye + MEAS_NOISE * rng.standard_normal(m)
-            u.tofile(fu)
-            y.tofile(fy)
-
-
-def generate_npy(path: Path, n: int, block: int = 1_000_000) -> None:
-    """The same process into one ``(n, 2)`` ``.npy`` file ``[u, y]`` (for ``--huge``)."""
-    rng = np.random.default_rng(SEED + 1)
-    out = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(n, 2))
+def _blocks(n: int, seed: int, block: int = 1_000_000):
+    """The benchmark process, ``block`` samples at a time: yields ``(lo, u, y)``."""
+    rng = np.random.default_rng(seed)
     zi_u = np.zeros(len(DEN) - 1)
     zi_e = np.zeros(len(DEN) - 1)
     for lo in range(0, n, block):
@@ -111,8 +93,23 @@ def generate_npy(path: Path, n: int, block: int = 1_000_000) -> None:
         e = EQ_NOISE * rng.standard_normal(m)
         yu, zi_u = signal.lfilter(NUM, DEN, u, zi=zi_u)
         ye, zi_e = signal.lfilter([1.0], DEN, e, zi=zi_e)
-        out[lo : lo + m, 0] = u
-        out[lo : lo + m, 1] = yu + ye + MEAS_NOISE * rng.standard_normal(m)
+        yield lo, u, yu + ye + MEAS_NOISE * rng.standard_normal(m)
+
+
+def generate(path_u: Path, path_y: Path, n: int) -> None:
+    """Write ``n`` samples of u and y (float64, raw binary) block by block."""
+    with open(path_u, "wb") as fu, open(path_y, "wb") as fy:
+        for _, u, y in _blocks(n, SEED):
+            u.tofile(fu)
+            y.tofile(fy)
+
+
+def generate_npy(path: Path, n: int) -> None:
+    """The same process into one ``(n, 2)`` ``.npy`` file ``[u, y]`` (for ``--huge``)."""
+    out = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(n, 2))
+    for lo, u, y in _blocks(n, SEED + 1):
+        out[lo : lo + u.size, 0] = u
+        out[lo : lo + u.size, 1] = y
     out.flush()
     del out
 

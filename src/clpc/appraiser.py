@@ -43,7 +43,7 @@ from .lpc import solution_info, structure_blocks
 from .regressors import Structure, check_mode, default_mode, miso_regressor
 from .sliding import window_scatter
 from .solve import RobustRule, fixed_transform, solve_scatter
-from .trace import Trace
+from .trace import PER_EQUATION, Trace
 
 __all__ = ["CLPC"]
 
@@ -762,9 +762,7 @@ class CLPC:
         ints = ("n_null", "n_input_relations")
         bools = ("degenerate", "determined", "accepted", "has_model", "stable")
         arrays = {}
-        for key in ("theta", "theta_estimate", "den", "num", "eigenvalues", "lambda_min",
-                    "lambda_max", "D", "eig_ratio", "separation", "noise_variance", "J", "c",
-                    "a0_weight", *ints, *bools):
+        for key in PER_EQUATION:
             dtype = np.int64 if key in ints else (bool if key in bools else np.float64)
             arrays[key] = np.zeros((0, e, *shapes.get(key, ())), dtype=dtype)
         z = np.zeros(0)

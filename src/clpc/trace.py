@@ -32,7 +32,7 @@ SCALAR_KEYS = (
     "stable",
 )
 # every per-update array; axis 1 (when present) is the equation (output) axis
-_PER_EQUATION = ("theta", "theta_estimate", "den", "num", "eigenvalues", *SCALAR_KEYS)
+PER_EQUATION = ("theta", "theta_estimate", "den", "num", "eigenvalues", *SCALAR_KEYS)
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class Trace:
     not_enough_data : ndarray of bool, shape (n,)
         Fewer rows than ``min_rows``: the estimate is not used.
     arrays : dict
-        Per-equation arrays (see :data:`_PER_EQUATION`): ``theta`` (held output, unit norm,
+        Per-equation arrays (see :data:`PER_EQUATION`): ``theta`` (held output, unit norm,
         paper convention), ``theta_estimate`` (this window's solution), ``den``/``num``
         (monic, ascending powers of ``z^-1``, of the held ``theta``), eigenvalues,
         ``lambda_min``, ``lambda_max``, ``D``, ``eig_ratio``, ``separation``,
