@@ -19,7 +19,14 @@ import numpy as np
 from .data import DataError, IOData, as_iodata
 from .model import LinearModel
 from .regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from .solve import RobustRule, SolveResult, index_j, log_likelihood, solve_scatter
+from .solve import (
+    RobustRule,
+    SolveResult,
+    index_j,
+    likelihood_variance,
+    log_likelihood,
+    solve_scatter,
+)
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
 
@@ -108,6 +115,7 @@ def solution_info(
     lam_min, lam_max = vals[..., 0], vals[..., -1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(lam_max > 0, lam_min / np.where(lam_max > 0, lam_max, 1.0), 1.0)
+    ll_var = likelihood_variance(noise_variance, lam_max, np.asarray(n_rows))
     determined = (
         (n_null == 1) & (n_input_relations == 0) & (separation <= rule.separation) & ~degenerate
     )
@@ -120,8 +128,8 @@ def solution_info(
         "separation": separation,
         "c": c,
         "noise_variance": noise_variance,
-        "log_likelihood": log_likelihood(noise_variance, n_rows),
-        "J": index_j(noise_variance, n_rows),
+        "log_likelihood": log_likelihood(ll_var, n_rows),
+        "J": index_j(ll_var, n_rows),
         "n_rows": np.asarray(n_rows),
         "n_null": n_null,
         "n_input_relations": n_input_relations,

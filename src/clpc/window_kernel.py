@@ -27,6 +27,9 @@ import numba
 import numpy as np
 
 from . import small_eigh
+from .solve import ROUNDING_VARIANCE_FACTOR
+
+_ROUNDING_VARIANCE = ROUNDING_VARIANCE_FACTOR * float(np.finfo(np.float64).eps)
 
 __all__ = ["solve_windows"]
 
@@ -405,7 +408,9 @@ def finish_updates(
             lambda_max[w, e] = hi
             D[w, e] = hi - lo
             eig_ratio[w, e] = lo / hi if hi > 0 else 1.0
-            J[w, e] = 0.5 * n_rows[w] * (math.log(max(noise_variance[w, e], tiny)) + 1.0)
+            floor = _ROUNDING_VARIANCE * max(hi, 0.0) / max(n_rows[w], 1)
+            var = max(noise_variance[w, e], floor, tiny)
+            J[w, e] = 0.5 * n_rows[w] * (math.log(var) + 1.0)
             det = (
                 n_null[w, e] == 1 and n_input[w, e] == 0
                 and separation[w, e] <= separation_tol and not degenerate[w, e]
