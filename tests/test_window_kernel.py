@@ -17,8 +17,15 @@ NUM = np.array([0.2, 0.5, 0.1])
 FLOAT_KEYS = ("theta", "theta_estimate", "c", "den", "num")
 # eigenvalues carry an absolute error of a few eps * lambda_max (either solver)
 EIGEN_KEYS = ("eigenvalues", "D", "lambda_min", "lambda_max")
-FLAG_KEYS = ("accepted", "has_model", "degenerate", "determined", "n_null",
-             "n_input_relations", "stable")
+FLAG_KEYS = (
+    "accepted",
+    "has_model",
+    "degenerate",
+    "determined",
+    "n_null",
+    "n_input_relations",
+    "stable",
+)
 
 
 # ---------------------------------------------------------------- the eigen-solver

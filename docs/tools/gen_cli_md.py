@@ -1,4 +1,5 @@
 """Run the documented commands and paste their real output into docs/cli.md."""
+
 import os
 import re
 import shutil
@@ -17,8 +18,9 @@ env = dict(os.environ, DATA=DATA, PATH=f"/work/venv/bin:{os.environ['PATH']}")
 
 def sh(cmd: str) -> str:
     """Run one documented shell command; its output as it would appear in a terminal."""
-    p = subprocess.run(["bash", "-c", "{ " + cmd + " ; } 2>&1"], cwd=WORK, env=env,
-                       capture_output=True, text=True)
+    p = subprocess.run(
+        ["bash", "-c", "{ " + cmd + " ; } 2>&1"], cwd=WORK, env=env, capture_output=True, text=True
+    )
     out = p.stdout.rstrip("\n").replace(DATA, "$DATA")
     code = f"\n[exit code {p.returncode}]" if p.returncode else ""
     return f"$ {cmd}\n{out}{code}"

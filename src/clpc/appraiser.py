@@ -51,9 +51,21 @@ _WINDOWS_PER_BATCH = 2048
 # scalar sample types step() takes without building arrays
 _SCALAR_TYPES = frozenset({float, int, np.float64, np.float32, np.int64, np.int32})
 # per-window statistics a solve hands to the FSM output logic
-_SOLVE_KEYS = ("eigenvalues", "lambda_min", "lambda_max", "D", "eig_ratio", "separation",
-               "noise_variance", "J", "c", "n_null", "n_input_relations", "degenerate",
-               "determined")
+_SOLVE_KEYS = (
+    "eigenvalues",
+    "lambda_min",
+    "lambda_max",
+    "D",
+    "eig_ratio",
+    "separation",
+    "noise_variance",
+    "J",
+    "c",
+    "n_null",
+    "n_input_relations",
+    "degenerate",
+    "determined",
+)
 # an estimate whose y(n) coefficient is below this in the solved (whitened) problem does not
 # determine y(n): it has no usable monic form and is never accepted
 _MIN_A0_WEIGHT = 1e-3
@@ -165,9 +177,7 @@ class CLPC:
         self.window_size = _positive_int(window_size, "window_size", 2)
         self.cluster_size = _positive_int(12 if cluster is None else cluster, "cluster_size")
         order = self.parameters_size - 1
-        self.structure = Structure(
-            order if na is None else na, order if nb is None else nb, nk
-        )
+        self.structure = Structure(order if na is None else na, order if nb is None else nb, nk)
         if method not in ("robust", "paper"):
             raise ValueError(f"method must be 'robust' or 'paper'; got {method!r}.")
         self.method = method
@@ -459,8 +469,7 @@ class CLPC:
             mats = [miso_regressor(y[:, j], u, self.structure) for j in range(self._n_out)]
         else:
             mats = [
-                miso_regressor(y[:, j], u[:, j : j + 1], self.structure)
-                for j in range(self._n_out)
+                miso_regressor(y[:, j], u[:, j : j + 1], self.structure) for j in range(self._n_out)
             ]
         return np.stack(mats)
 
@@ -484,8 +493,7 @@ class CLPC:
                 n_batches = -(-n_batches // self.n_jobs) * self.n_jobs
             size = -(-n_new // n_batches)
             batches = [
-                (j0, min(size, j_last + 1 - j0))
-                for j0 in range(self._j_done + 1, j_last + 1, size)
+                (j0, min(size, j_last + 1 - j0)) for j0 in range(self._j_done + 1, j_last + 1, size)
             ]
             # windows are independent: the batches are solved in parallel when asked; the
             # hold logic of the FSM output then runs in time order
@@ -530,9 +538,7 @@ class CLPC:
             self._pool = ThreadPoolExecutor(self.n_jobs)
         return self._pool
 
-    def _solve_windows(
-        self, rows: np.ndarray | None, j0: int, count: int
-    ) -> dict[str, np.ndarray]:
+    def _solve_windows(self, rows: np.ndarray | None, j0: int, count: int) -> dict[str, np.ndarray]:
         """Solve windows ``j0 .. j0 + count - 1``: arrays of shape (count, E, ...).
 
         ``rows``: the buffer's lag rows (numpy engine; the compiled one reads the samples).
@@ -554,10 +560,17 @@ class CLPC:
             noise_cov=self._noise(),
             rule=self.rule,
         )
-        out = {"theta_estimate": res.theta, "eigenvalues": res.eigenvalues, "c": res.c,
-               "noise_variance": res.noise_variance, "separation": res.separation,
-               "a0_weight": res.a0_weight, "n_null": res.n_null,
-               "n_input_relations": res.n_input_relations, "degenerate": res.degenerate}
+        out = {
+            "theta_estimate": res.theta,
+            "eigenvalues": res.eigenvalues,
+            "c": res.c,
+            "noise_variance": res.noise_variance,
+            "separation": res.separation,
+            "a0_weight": res.a0_weight,
+            "n_null": res.n_null,
+            "n_input_relations": res.n_input_relations,
+            "degenerate": res.degenerate,
+        }
         # (E * count, ...) -> (count, E, ...)
         for key, val in out.items():
             out[key] = np.swapaxes(val.reshape(e, count, *val.shape[1:]), 0, 1)
@@ -625,17 +638,29 @@ class CLPC:
             "n_rows_win": np.empty(count, dtype=np.int64),
         }
         lay["kernel"].solve_windows(
-            self._buf, self._buf_start - self.structure.max_lag, lay["chan"], lay["lag"],
-            j0, count, self.window_size, self.cluster_size, lay["col_channel"],
-            lay["n_channels"], self.structure.na + 1, lay["mode"], lay["transform"],
-            self.method == "robust", lay["opts"], *out.values(),
+            self._buf,
+            self._buf_start - self.structure.max_lag,
+            lay["chan"],
+            lay["lag"],
+            j0,
+            count,
+            self.window_size,
+            self.cluster_size,
+            lay["col_channel"],
+            lay["n_channels"],
+            self.structure.na + 1,
+            lay["mode"],
+            lay["transform"],
+            self.method == "robust",
+            lay["opts"],
+            *out.values(),
         )
         return out
 
     def _finish(self, res: dict[str, np.ndarray], j0: int, count: int) -> Trace:
         """Accept/hold logic of the FSM output, monic forms, stability, statistics."""
-        arrays = self._finish_compiled(res) if self.engine == "compiled" else (
-            self._finish_numpy(res)
+        arrays = (
+            self._finish_compiled(res) if self.engine == "compiled" else (self._finish_numpy(res))
         )
         n_rows = arrays.pop("n_rows_win")
         not_enough = arrays.pop("not_enough")
@@ -665,14 +690,40 @@ class CLPC:
             "J": np.empty((count, e)),
         }
         self._kernel_layout()["kernel"].finish_updates(
-            res["theta_estimate"], res["c"], res["eigenvalues"], res["noise_variance"],
-            res["separation"], res["a0_weight"], res["n_null"], res["n_input_relations"],
-            res["degenerate"], res["n_rows_win"], self._min_rows(), self.gate,
-            _MIN_A0_WEIGHT, rule.separation, s.na, s.nb, s.nk, self._mode() != "miso",
-            self._last_theta, self._last_c, self._has_model, *out.values(),
+            res["theta_estimate"],
+            res["c"],
+            res["eigenvalues"],
+            res["noise_variance"],
+            res["separation"],
+            res["a0_weight"],
+            res["n_null"],
+            res["n_input_relations"],
+            res["degenerate"],
+            res["n_rows_win"],
+            self._min_rows(),
+            self.gate,
+            _MIN_A0_WEIGHT,
+            rule.separation,
+            s.na,
+            s.nb,
+            s.nk,
+            self._mode() != "miso",
+            self._last_theta,
+            self._last_c,
+            self._has_model,
+            *out.values(),
         )
-        for key in ("theta_estimate", "eigenvalues", "noise_variance", "separation",
-                    "a0_weight", "n_null", "n_input_relations", "degenerate", "n_rows_win"):
+        for key in (
+            "theta_estimate",
+            "eigenvalues",
+            "noise_variance",
+            "separation",
+            "a0_weight",
+            "n_null",
+            "n_input_relations",
+            "degenerate",
+            "n_rows_win",
+        ):
             out[key] = res[key]
         return out
 
@@ -682,8 +733,14 @@ class CLPC:
         n_rows = res["n_rows_win"]
         count = n_rows.shape[0]
         info = solution_info(
-            res["eigenvalues"], res["c"], res["noise_variance"], res["n_null"],
-            res["n_input_relations"], res["separation"], res["degenerate"], n_rows[:, None],
+            res["eigenvalues"],
+            res["c"],
+            res["noise_variance"],
+            res["n_null"],
+            res["n_input_relations"],
+            res["separation"],
+            res["degenerate"],
+            n_rows[:, None],
             self.rule,
         )
         not_enough = n_rows < self._min_rows()
@@ -705,9 +762,19 @@ class CLPC:
         self._has_model = has_model[-1].copy()
         den, num, stable = self._monic(theta, has_model)
         arrays = {key: info[key] for key in _SOLVE_KEYS}
-        arrays.update(theta_estimate=est, a0_weight=res["a0_weight"], theta=theta, c=c_out,
-                      accepted=accepted, has_model=has_model, den=den, num=num, stable=stable,
-                      n_rows_win=n_rows, not_enough=not_enough)
+        arrays.update(
+            theta_estimate=est,
+            a0_weight=res["a0_weight"],
+            theta=theta,
+            c=c_out,
+            accepted=accepted,
+            has_model=has_model,
+            den=den,
+            num=num,
+            stable=stable,
+            n_rows_win=n_rows,
+            not_enough=not_enough,
+        )
         return arrays
 
     def _monic(
@@ -756,8 +823,11 @@ class CLPC:
         p = self._p() if self._n_in is not None else self.structure.n_params()
         s = self.structure
         shapes = {
-            "theta": (p,), "theta_estimate": (p,), "den": (s.na + 1,),
-            "num": (self._n_in or 1, s.nk + s.nb + 1), "eigenvalues": (p,),
+            "theta": (p,),
+            "theta_estimate": (p,),
+            "den": (s.na + 1,),
+            "num": (self._n_in or 1, s.nk + s.nb + 1),
+            "eigenvalues": (p,),
         }
         ints = ("n_null", "n_input_relations")
         bools = ("degenerate", "determined", "accepted", "has_model", "stable")

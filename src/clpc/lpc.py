@@ -91,8 +91,15 @@ def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str
     ``degenerate``, ``determined``.
     """
     return solution_info(
-        res.eigenvalues, res.c, res.noise_variance, res.n_null, res.n_input_relations,
-        res.separation, res.degenerate, n_rows, rule,
+        res.eigenvalues,
+        res.c,
+        res.noise_variance,
+        res.n_null,
+        res.n_input_relations,
+        res.separation,
+        res.degenerate,
+        n_rows,
+        rule,
     )
 
 

@@ -111,9 +111,7 @@ def select_order(
             f"criterion must be 'remark1', 'aic', 'bic' or 'validation'; got {criterion!r}."
         )
     if not 0.0 < validation_fraction < 1.0:
-        raise ValueError(
-            f"validation_fraction must be in (0, 1); got {validation_fraction!r}."
-        )
+        raise ValueError(f"validation_fraction must be in (0, 1); got {validation_fraction!r}.")
     orders = np.array(sorted({int(o) for o in orders}))
     if orders.size == 0 or orders[0] < 1:
         raise ValueError(f"orders must be ints >= 1; got {orders.tolist()}.")
@@ -155,9 +153,7 @@ def select_order(
                 best = int(orders[i])
             else:
                 break
-    return OrderSelection(
-        orders, J, ll, aic, bic, var, n_par.astype(int), best, criterion, val_fit
-    )
+    return OrderSelection(orders, J, ll, aic, bic, var, n_par.astype(int), best, criterion, val_fit)
 
 
 def _validation_fits(

@@ -238,16 +238,34 @@ class Trace:
         run = np.convolve(quiet.astype(int), np.ones(consecutive, dtype=int), "valid")
         hits = np.flatnonzero(run == consecutive) if run.size else np.array([], int)
         if hits.size == 0:
-            return Convergence(False, -1, -1, float("nan"), theta_tol, D_tol, consecutive,
-                               float("nan"), float("nan"))
+            return Convergence(
+                False,
+                -1,
+                -1,
+                float("nan"),
+                theta_tol,
+                D_tol,
+                consecutive,
+                float("nan"),
+                float("nan"),
+            )
         start = int(hits[0])
         after = acc & (np.arange(n) >= start)
         ss = _mean_theta(theta[after])
         th_var = float(np.linalg.norm(theta[after] - ss[None], axis=2).max())
         d_mean = d[after].mean(axis=0)
         d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
-        return Convergence(True, start, int(self.index[start]), float(self.time[start]),
-                           theta_tol, D_tol, consecutive, th_var, d_var)
+        return Convergence(
+            True,
+            start,
+            int(self.index[start]),
+            float(self.time[start]),
+            theta_tol,
+            D_tol,
+            consecutive,
+            th_var,
+            d_var,
+        )
 
     def steady_state_model(
         self, convergence: Convergence | None = None, *, allow_unconverged: bool = False
@@ -290,8 +308,11 @@ class Trace:
             dt=self.sample_time,
             input_names=self.input_names,
             output_names=self.output_names,
-            info={"convergence": conv, "method": "clpc-steady-state",
-                  "updates_used": int(sel.sum())},
+            info={
+                "convergence": conv,
+                "method": "clpc-steady-state",
+                "updates_used": int(sel.sum()),
+            },
         )
 
 

@@ -56,8 +56,10 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
         except ValueError:
             stable = False
-        msgs = ("no fit statistics (an averaged or loaded model)",
-                "the model is stable" if stable else "the model is NOT stable")
+        msgs = (
+            "no fit statistics (an averaged or loaded model)",
+            "the model is stable" if stable else "the model is NOT stable",
+        )
         return Verdict(0, True, False, stable, model.structure.nb + 1, msgs)
     n_null = int(np.asarray(info["n_null"])[output])
     n_input = int(np.asarray(info["n_input_relations"])[output])
@@ -129,8 +131,10 @@ def describe_trace(trace: Any) -> list[str]:
 
     add(trace.not_enough_data, "fewer lag vectors than min_rows")
     add(arr["degenerate"].any(axis=1), "nothing varies (degenerate window)")
-    add((arr["n_input_relations"] > 0).any(axis=1),
-        f"input is not persistently exciting of order {order}")
+    add(
+        (arr["n_input_relations"] > 0).any(axis=1),
+        f"input is not persistently exciting of order {order}",
+    )
     poorly = ~arr["determined"].any(axis=1) & ~arr["degenerate"].any(axis=1)
     poorly &= ~trace.not_enough_data & ~(arr["n_input_relations"] > 0).any(axis=1)
     add(poorly, "the window does not determine the parameters")

@@ -49,6 +49,7 @@ def _sym_eig(a, d, v, e, vectors):  # pragma: no cover - compiled
     _tred2(v, d, e, n)
     return _tql2(v, d, e, n, vectors)
 
+
 # transform modes of the solved problem T^T A T
 NO_TRANSFORM, CHANNEL_SCALES, FIXED_TRANSFORM = 0, 1, 2
 # layout of the float options vector
@@ -120,8 +121,19 @@ def _merge(b_mean, b_scat, lo, hi, size, t_size, t_mean, t_scat, dev, mean, scat
 
 @_jit
 def _solve_one(
-    scat, mean, n_rows, col_channel, n_channels, n_out_cols, transform_mode, transform,
-    robust, opts, work, out_theta, out_vals,
+    scat,
+    mean,
+    n_rows,
+    col_channel,
+    n_channels,
+    n_out_cols,
+    transform_mode,
+    transform,
+    robust,
+    opts,
+    work,
+    out_theta,
+    out_vals,
 ):  # pragma: no cover - compiled
     """LPC of one window (see :func:`clpc.solve.solve_scatter`, same rules).
 
@@ -300,10 +312,31 @@ def _ratio(num, den):  # pragma: no cover - compiled
 
 @_jit
 def solve_windows(
-    samples, first_row, col_chan, col_lag, j0, count, window, cluster, col_channel,
-    n_channels, n_out_cols, transform_mode, transform, robust, opts,
-    theta, eigenvalues, c, noise_variance, separation, a0_weight, n_null, n_input,
-    degenerate, n_rows_out,
+    samples,
+    first_row,
+    col_chan,
+    col_lag,
+    j0,
+    count,
+    window,
+    cluster,
+    col_channel,
+    n_channels,
+    n_out_cols,
+    transform_mode,
+    transform,
+    robust,
+    opts,
+    theta,
+    eigenvalues,
+    c,
+    noise_variance,
+    separation,
+    a0_weight,
+    n_null,
+    n_input,
+    degenerate,
+    n_rows_out,
 ):  # pragma: no cover - compiled
     """Solve windows ``j = j0 .. j0 + count - 1`` of every equation; fill the outputs.
 
@@ -345,8 +378,14 @@ def solve_windows(
     scat = np.empty((p, p))
     z = np.empty(p)
     work = (
-        np.empty((p, p)), np.empty(p), np.empty((p, p)), np.empty(p), np.empty((p, p)),
-        np.empty(p), np.empty(p), np.empty(p),
+        np.empty((p, p)),
+        np.empty(p),
+        np.empty((p, p)),
+        np.empty(p),
+        np.empty((p, p)),
+        np.empty(p),
+        np.empty(p),
+        np.empty(p),
     )
     for eq in range(n_eq):
         chan = col_chan[eq]
@@ -362,11 +401,33 @@ def solve_windows(
             t_size = full_lo * cluster - s  # the tail of the block holding s, if any
             if t_size > 0:
                 _piece_stats(samples, chan, lag, first, s, full_lo * cluster, z, t_mean, t_scat)
-            n_w = _merge(b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster, t_size, t_mean,
-                         t_scat, dev, mean, scat)
+            n_w = _merge(
+                b_mean,
+                b_scat,
+                full_lo - b_lo,
+                j - b_lo,
+                cluster,
+                t_size,
+                t_mean,
+                t_scat,
+                dev,
+                mean,
+                scat,
+            )
             out = _solve_one(
-                scat, mean, n_w, col_channel, n_channels, n_out_cols, transform_mode,
-                transform, robust, opts, work, theta[w, eq], eigenvalues[w, eq],
+                scat,
+                mean,
+                n_w,
+                col_channel,
+                n_channels,
+                n_out_cols,
+                transform_mode,
+                transform,
+                robust,
+                opts,
+                work,
+                theta[w, eq],
+                eigenvalues[w, eq],
             )
             c[w, eq] = out[0]
             noise_variance[w, eq] = out[1]
@@ -380,11 +441,41 @@ def solve_windows(
 
 @_jit
 def finish_updates(
-    theta_est, c_est, eigenvalues, noise_variance, separation, a0_weight, n_null, n_input,
-    degenerate, n_rows, min_rows, gate, min_a0_weight, separation_tol, na, nb, nk, paired,
-    last_theta, last_c, has_model_state,
-    theta, c, accepted, has_model, determined, not_enough, den, num, stable,
-    lambda_min, lambda_max, D, eig_ratio, J,
+    theta_est,
+    c_est,
+    eigenvalues,
+    noise_variance,
+    separation,
+    a0_weight,
+    n_null,
+    n_input,
+    degenerate,
+    n_rows,
+    min_rows,
+    gate,
+    min_a0_weight,
+    separation_tol,
+    na,
+    nb,
+    nk,
+    paired,
+    last_theta,
+    last_c,
+    has_model_state,
+    theta,
+    c,
+    accepted,
+    has_model,
+    determined,
+    not_enough,
+    den,
+    num,
+    stable,
+    lambda_min,
+    lambda_max,
+    D,
+    eig_ratio,
+    J,
 ):  # pragma: no cover - compiled
     """The FSM output of solved windows, in time order (``CLPC._finish_numpy``, compiled).
 
@@ -412,8 +503,10 @@ def finish_updates(
             var = max(noise_variance[w, e], floor, tiny)
             J[w, e] = 0.5 * n_rows[w] * (math.log(var) + 1.0)
             det = (
-                n_null[w, e] == 1 and n_input[w, e] == 0
-                and separation[w, e] <= separation_tol and not degenerate[w, e]
+                n_null[w, e] == 1
+                and n_input[w, e] == 0
+                and separation[w, e] <= separation_tol
+                and not degenerate[w, e]
             )
             determined[w, e] = det
             ok = not few and not degenerate[w, e] and a0_weight[w, e] >= min_a0_weight
