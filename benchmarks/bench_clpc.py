@@ -6,7 +6,7 @@ system ``A(q) y = B(q) u + e`` with ``A = 1 - 1.5 q^-1 + 0.7 q^-2``, ``B = 0.5 +
 ``y``. Settings: ``N = 2`` (``parameters_size = 3``), ``W = 201``, ``C = 12``.
 
 Engines (``CLPC(engine=...)``): ``compiled`` is the numba kernel of
-:mod:`clpc.window_kernel` (the default, ``engine="auto"``, when numba is installed);
+:mod:`clpc.appraiser.kernel` (the default, ``engine="auto"``, when numba is installed);
 ``numpy`` is the vectorised numpy/LAPACK engine. Every ``clpc`` row of the tables names the
 engine it used; the references have none (``-``). Measured with both engines: batch at every
 ``T``, ``push(10000)``, ``step``, ``cluster_size=1`` and the exactness checks; with the
@@ -1022,7 +1022,7 @@ def main(argv: list[str] | None = None) -> int:
             cell += (
                 f"; added > 100 MB at T = {', '.join(fmt_n(n) for n in over)} because the "
                 "returned trace grows with T: for bounded memory use push + "
-                "clpc.tracefile.TraceWriter"
+                "clpc.appraiser.tracefile.TraceWriter"
             )
         cells.append(cell)
         flags[eng] = not over

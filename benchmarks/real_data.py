@@ -52,7 +52,7 @@ import numpy as np
 
 import clpc
 from clpc import datasets
-from clpc.regressors import Structure, miso_regressor
+from clpc.lpc.regressors import Structure, miso_regressor
 
 RECORDS = (
     "robot_arm",

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from clpc.lpc.regressors import Structure
 from clpc.model import LinearModel
-from clpc.regressors import Structure
 
 SEED = 20240607
 

@@ -19,7 +19,7 @@ import clpc
 import clpc.datasets as ds
 from clpc.cli import cli
 from clpc.io import read_table, write_table
-from clpc.model_io import load_model
+from clpc.io.model_files import load_model
 from clpc.report import model_response, update_records
 
 DRYER = str(ds.path("dryer"))
@@ -484,7 +484,8 @@ def test_usage_errors_exit_2(record, tmp_path):
 
 # ================================================================= demo
 def test_demo_reports_missing_experiment(monkeypatch, tmp_path):
-    monkeypatch.setitem(sys.modules, "clpc.experiment", None)  # import now fails
+    for name in ("clpc.experiment", "clpc.experiment.run"):
+        monkeypatch.setitem(sys.modules, name, None)  # import now fails
     r = fails(1, "demo", "--out", tmp_path)
     assert "needs clpc.experiment" in r.output
 
@@ -500,7 +501,7 @@ def test_demo_quick(tmp_path):
 
 
 def test_claim_text():
-    from clpc.cli import _claim_text
+    from clpc.cli.commands import _claim_text
 
     claim = {
         "id": "D",

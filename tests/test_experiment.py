@@ -16,9 +16,9 @@ import pytest
 from scipy import signal
 
 import clpc
-from clpc import experiment as ex
-from clpc.experiment_report import render_report
-from clpc.paper_figures import FILES, RICH_FILE
+from clpc.experiment import run as ex
+from clpc.experiment.figures import FILES, RICH_FILE
+from clpc.experiment.report import render_report
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -11,7 +11,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from clpc import io as cio
 from clpc.data import DataError, IOData
 from clpc.io import (
     DataFileNotFoundError,
@@ -21,6 +20,7 @@ from clpc.io import (
     read_table,
     write_table,
 )
+from clpc.io import tables as cio
 
 VALUES = np.array([[0.0, 1.5, -2.0], [0.1, 2.5, 3.25], [0.2, -1e-3, 4e5]])
 

@@ -18,7 +18,7 @@ from scipy import signal
 import clpc
 from clpc import ARX, LPC, DataError, IOData, lpc_solve
 from clpc.lpc import structure_blocks
-from clpc.regressors import Structure, regressors
+from clpc.lpc.regressors import Structure, regressors
 
 METHODS = ["paper", "robust"]
 

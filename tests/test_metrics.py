@@ -10,7 +10,7 @@ import pytest
 from scipy import signal, stats
 
 from clpc import fit_percent, kstep_fit, rmse, simulate_arx, vaf, whiteness_test
-from clpc.metrics import WhitenessResult
+from clpc.analysis.metrics import WhitenessResult
 
 Y = [1.0, 2.0, 4.0, 3.0, 5.0]
 Y_HAT = [1.5, 2.0, 3.0, 3.5, 4.0]

@@ -11,7 +11,7 @@ from scipy import signal
 
 import clpc
 from clpc import LPC, LinearModel, ModelError
-from clpc.regressors import Structure
+from clpc.lpc.regressors import Structure
 
 # a stable, minimum-phase system with a delay: poles |p| = 0.84, zeros of 0.5 + 0.3z + 0.1z^2
 DEN = np.array([1.0, -1.5, 0.7])

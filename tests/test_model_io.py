@@ -9,8 +9,7 @@ import pytest
 
 import clpc
 from clpc.data import DataError
-from clpc.model import LinearModel
-from clpc.model_io import (
+from clpc.io.model_files import (
     FORMAT,
     SCHEMA_VERSION,
     ModelFileError,
@@ -19,7 +18,8 @@ from clpc.model_io import (
     model_to_dict,
     save_model,
 )
-from clpc.regressors import Structure
+from clpc.lpc.regressors import Structure
+from clpc.model import LinearModel
 
 
 def _records(rng, n=600):

@@ -3,7 +3,7 @@ import pytest
 
 import clpc
 from clpc import DataError
-from clpc.noise import estimate_noise_variances
+from clpc.lpc.noise import estimate_noise_variances
 
 DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.2, 0.5, 0.1])

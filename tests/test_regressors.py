@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from clpc import DataError, IOData, Structure
-from clpc.regressors import (
+from clpc.lpc.regressors import (
     check_mode,
     column_labels,
     default_mode,

@@ -3,9 +3,8 @@ import pytest
 
 import clpc
 from clpc import CLPC
+from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter, trace_columns
 from clpc.io import read_table
-from clpc.report import trace_columns
-from clpc.tracefile import ThinnedTrace, TraceWriter
 
 
 def parts_and_whole():

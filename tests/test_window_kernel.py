@@ -7,8 +7,8 @@ import pytest
 
 import clpc
 from clpc import CLPC, DataError, Trace
-from clpc import appraiser as appraiser_module
-from clpc.small_eigh import sym_eig
+from clpc.appraiser import facade as appraiser_module
+from clpc.core.small_eigh import sym_eig
 
 pytest.importorskip("numba")
 

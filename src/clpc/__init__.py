@@ -6,22 +6,28 @@ centered scatter matrix of lag vectors); CLPC runs it window by window as a fini
 machine and reports time-varying parameters and the degree of linearity of each cluster.
 """
 
-from .appraiser import CLPC
-from .arx import ARX, simulate_arx
-from .data import DataError, IOData, as_iodata
-from .io import load_iodata, read_table, write_table
-from .lpc import LPC, lpc_solve
-from .metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
-from .model import LinearModel, ModelError
-from .model_io import load_model, save_model
-from .noise import NoiseEstimate, estimate_noise_variances
-from .order import DelaySelection, OrderSelection, select_delay, select_order
-from .regressors import Structure
-from .solve import RobustRule
-from .trace import Convergence, Trace
-from .verdict import Verdict, describe_trace, fit_verdict
+from clpc import _moved
+from clpc._version import __version__
+from clpc.analysis.metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
+from clpc.appraiser import CLPC, Convergence, Trace
+from clpc.data import DataError, IOData, as_iodata
+from clpc.io import load_iodata, load_model, read_table, save_model, write_table
+from clpc.lpc import (
+    ARX,
+    LPC,
+    DelaySelection,
+    NoiseEstimate,
+    OrderSelection,
+    RobustRule,
+    estimate_noise_variances,
+    lpc_solve,
+    select_delay,
+    select_order,
+    simulate_arx,
+)
+from clpc.model import LinearModel, ModelError, Structure, Verdict, describe_trace, fit_verdict
 
-__version__ = "0.1.0"
+_moved.install()
 
 __all__ = [
     "ARX",
@@ -39,6 +45,7 @@ __all__ = [
     "Structure",
     "Trace",
     "Verdict",
+    "__version__",
     "as_iodata",
     "describe_trace",
     "estimate_noise_variances",

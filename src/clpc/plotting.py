@@ -21,8 +21,8 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-    from .model import LinearModel
-    from .trace import Trace
+    from clpc.appraiser.trace import Trace
+    from clpc.model import LinearModel
 
 __all__ = ["plot_bode", "plot_compare", "plot_pz", "plot_trace"]
 

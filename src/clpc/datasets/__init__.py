@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import IOData
+from clpc.data import IOData
 
 __all__ = ["DATASETS", "Dataset", "load", "names"]
 

@@ -23,16 +23,17 @@ from typing import Any
 import click
 import numpy as np
 
-from . import __version__
-from . import datasets as _datasets
-from .appraiser import CLPC
-from .data import DataError, IOData
-from .io import iter_table_chunks, load_iodata, read_table, write_table
-from .lpc import LPC
-from .model import LinearModel, ModelError
-from .model_io import load_model, save_model
-from .order import select_order
-from .report import (
+from clpc import datasets as _datasets
+from clpc._version import __version__
+from clpc.appraiser.facade import CLPC
+from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
+from clpc.data import DataError, IOData
+from clpc.io import iter_table_chunks, load_iodata, read_table, write_table
+from clpc.io.model_files import load_model, save_model
+from clpc.lpc.estimator import LPC
+from clpc.lpc.order import select_order
+from clpc.model import LinearModel, ModelError
+from clpc.report import (
     format_fit,
     format_model_summary,
     jsonable,
@@ -43,7 +44,6 @@ from .report import (
     update_records,
     write_track_report,
 )
-from .tracefile import ThinnedTrace, TraceWriter
 
 __all__ = ["cli", "main"]
 
@@ -907,7 +907,7 @@ def compare(
         "fit": dict(zip(outs, jsonable(fit), strict=True)),
     }
     if plot:
-        from .plotting import plot_compare
+        from clpc.plotting import plot_compare
 
         plot_compare(data.time, data.y, y_hat, fit, plot, names=outs, label=what)
         result["plot"] = plot
@@ -994,7 +994,7 @@ def demo(
       clpc demo --out demo/ --quick
     """  # noqa: D301
     try:
-        from .experiment import run_experiment
+        from clpc.experiment.run import run_experiment
     except ImportError as exc:
         raise click.ClickException(
             f"the demo needs clpc.experiment, which is not available here ({exc})."

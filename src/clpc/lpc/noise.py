@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from .data import DataError, as_iodata
-from .regressors import Structure, siso_regressor
+from clpc.data import DataError, as_iodata
+from clpc.lpc.regressors import Structure, siso_regressor
 
 __all__ = ["NoiseEstimate", "estimate_noise_variances"]
 

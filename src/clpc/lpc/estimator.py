@@ -16,10 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from .data import DataError, IOData, as_iodata
-from .model import LinearModel
-from .regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from .solve import (
+from clpc.data import DataError, IOData, as_iodata
+from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from clpc.lpc.solve import (
     RobustRule,
     SolveResult,
     index_j,
@@ -27,6 +26,7 @@ from .solve import (
     log_likelihood,
     solve_scatter,
 )
+from clpc.model import LinearModel
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
 

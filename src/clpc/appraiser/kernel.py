@@ -26,8 +26,8 @@ import math
 import numba
 import numpy as np
 
-from . import small_eigh
-from .solve import ROUNDING_VARIANCE_FACTOR
+from clpc.core import small_eigh
+from clpc.lpc.solve import ROUNDING_VARIANCE_FACTOR
 
 _ROUNDING_VARIANCE = ROUNDING_VARIANCE_FACTOR * float(np.finfo(np.float64).eps)
 

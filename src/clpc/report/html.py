@@ -25,11 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from .data import IOData
-from .metrics import fit_percent
-from .model import LinearModel
-from .trace import SCALAR_KEYS, Trace
-from .verdict import describe_trace, fit_verdict
+from clpc.analysis.metrics import fit_percent
+from clpc.appraiser.trace import SCALAR_KEYS, Trace
+from clpc.appraiser.tracefile import trace_columns
+from clpc.data import IOData
+from clpc.model import LinearModel
+from clpc.model.verdict import describe_trace, fit_verdict
 
 __all__ = [
     "Section",
@@ -303,43 +304,6 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
     return records
 
 
-def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
-    """A trace as a numeric table: column names and a float array (one row per update).
-
-    Columns: ``index``, ``time``, ``rows``, ``not_enough_data``, then per output (prefixed
-    ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
-    the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
-    flags are 0/1.
-    """
-    names = ["index", "time", "rows", "not_enough_data"]
-    cols = [trace.index, trace.time, trace.rows, trace.not_enough_data]
-    labels = trace.labels()
-    a = trace.arrays
-    s = trace.structure
-    for e in range(trace.n_equations):
-        pre = f"{trace.output_names[e]}:" if trace.n_equations > 1 else ""
-        for i, lab in enumerate(labels):
-            names.append(pre + lab)
-            cols.append(a["theta"][:, e, i])
-        for i in range(s.na + 1):
-            names.append(f"{pre}den{i}")
-            cols.append(a["den"][:, e, i])
-        for u in range(a["num"].shape[2]):
-            suffix = f"_{trace.input_names[u]}" if a["num"].shape[2] > 1 else ""
-            for i in range(a["num"].shape[3]):
-                names.append(f"{pre}num{i}{suffix}")
-                cols.append(a["num"][:, e, u, i])
-        for key in SCALAR_KEYS:
-            names.append(pre + key)
-            cols.append(a[key][:, e])
-    table = (
-        np.column_stack([np.asarray(c, dtype=np.float64) for c in cols])
-        if len(trace)
-        else (np.zeros((0, len(names))))
-    )
-    return names, table
-
-
 def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
     """The model a trace settles on, and where it comes from.
 
@@ -543,7 +507,7 @@ def write_track_report(
     list of Path
         The files written (the report last).
     """
-    from .plotting import plot_bode, plot_pz, plot_trace
+    from clpc.plotting import plot_bode, plot_pz, plot_trace
 
     out = Path(out_dir)
     summary = trace_summary(trace) if summary is None else summary

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .regressors import Structure
+from clpc.model.structure import Structure
 
 __all__ = ["LinearModel", "ModelError"]
 
@@ -214,7 +214,7 @@ class LinearModel:
 
     def verdict(self, output: int = 0) -> Any:
         """Identifiability of the fit in plain words (:func:`clpc.verdict.fit_verdict`)."""
-        from .verdict import fit_verdict
+        from clpc.model.verdict import fit_verdict
 
         return fit_verdict(self, output)
 

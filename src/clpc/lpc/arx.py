@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .data import as_iodata
-from .model import LinearModel
-from .regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from clpc.data import as_iodata
+from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from clpc.model import LinearModel
 
 __all__ = ["ARX", "simulate_arx"]
 

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from .data import as_iodata
-from .lpc import LPC
+from clpc.data import as_iodata
+from clpc.lpc.estimator import LPC
 
 __all__ = ["DelaySelection", "OrderSelection", "select_delay", "select_order"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .experiment import A0_MIN, D_QUASI_CONSTANT, LABELS
+from clpc.experiment.run import A0_MIN, D_QUASI_CONSTANT, LABELS
 
 __all__ = ["claims", "render_report"]
 

@@ -14,10 +14,47 @@ from typing import Any
 
 import numpy as np
 
-from .data import DataError
-from .trace import Trace
+from clpc.appraiser.trace import SCALAR_KEYS, Trace
+from clpc.data import DataError
 
-__all__ = ["ThinnedTrace", "TraceWriter"]
+__all__ = ["ThinnedTrace", "TraceWriter", "trace_columns"]
+
+
+def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
+    """A trace as a numeric table: column names and a float array (one row per update).
+
+    Columns: ``index``, ``time``, ``rows``, ``not_enough_data``, then per output (prefixed
+    ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
+    the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
+    flags are 0/1.
+    """
+    names = ["index", "time", "rows", "not_enough_data"]
+    cols = [trace.index, trace.time, trace.rows, trace.not_enough_data]
+    labels = trace.labels()
+    a = trace.arrays
+    s = trace.structure
+    for e in range(trace.n_equations):
+        pre = f"{trace.output_names[e]}:" if trace.n_equations > 1 else ""
+        for i, lab in enumerate(labels):
+            names.append(pre + lab)
+            cols.append(a["theta"][:, e, i])
+        for i in range(s.na + 1):
+            names.append(f"{pre}den{i}")
+            cols.append(a["den"][:, e, i])
+        for u in range(a["num"].shape[2]):
+            suffix = f"_{trace.input_names[u]}" if a["num"].shape[2] > 1 else ""
+            for i in range(a["num"].shape[3]):
+                names.append(f"{pre}num{i}{suffix}")
+                cols.append(a["num"][:, e, u, i])
+        for key in SCALAR_KEYS:
+            names.append(pre + key)
+            cols.append(a[key][:, e])
+    table = (
+        np.column_stack([np.asarray(c, dtype=np.float64) for c in cols])
+        if len(trace)
+        else (np.zeros((0, len(names))))
+    )
+    return names, table
 
 
 class TraceWriter:
@@ -41,8 +78,6 @@ class TraceWriter:
 
     def write(self, part: Trace) -> None:
         """Append the rows of ``part`` (a trace of consecutive updates)."""
-        from .report import trace_columns  # the one definition of the table layout
-
         if not len(part):
             return
         names, table = trace_columns(part)

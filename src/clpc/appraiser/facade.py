@@ -38,12 +38,12 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .data import DataError, IOData, as_iodata
-from .lpc import solution_info, structure_blocks
-from .regressors import Structure, check_mode, default_mode, miso_regressor
-from .sliding import window_scatter
-from .solve import RobustRule, fixed_transform, solve_scatter
-from .trace import PER_EQUATION, Trace
+from clpc.appraiser.sliding import window_scatter
+from clpc.appraiser.trace import PER_EQUATION, Trace
+from clpc.data import DataError, IOData, as_iodata
+from clpc.lpc.estimator import solution_info, structure_blocks
+from clpc.lpc.regressors import Structure, check_mode, default_mode, miso_regressor
+from clpc.lpc.solve import RobustRule, fixed_transform, solve_scatter
 
 __all__ = ["CLPC"]
 
@@ -581,7 +581,7 @@ class CLPC:
         """Column maps and solve options of the compiled engine (fixed per record)."""
         if self._layout is not None:
             return self._layout
-        from . import window_kernel as wk  # imports numba: only when this engine is used
+        from clpc.appraiser import kernel as wk  # imports numba: only when this engine is used
 
         assert self._n_in is not None and self._n_out is not None
         s, n_in, n_out = self.structure, self._n_in, self._n_out

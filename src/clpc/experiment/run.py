@@ -33,13 +33,13 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .appraiser import CLPC
-from .arx import ARX
-from .lpc import LPC
-from .metrics import fit_percent, kstep_fit
-from .model import LinearModel, ModelError
-from .plants import ServoParameters, prbs, ramp_with_saturation, simulate_servo, trapezoid_moves
-from .trace import Convergence, Trace
+from clpc.analysis.metrics import fit_percent, kstep_fit
+from clpc.appraiser.facade import CLPC
+from clpc.appraiser.trace import Convergence, Trace
+from clpc.lpc.arx import ARX
+from clpc.lpc.estimator import LPC
+from clpc.model import LinearModel, ModelError
+from clpc.plants import ServoParameters, prbs, ramp_with_saturation, simulate_servo, trapezoid_moves
 
 __all__ = ["decimate", "error_profile", "free_run", "run_experiment", "stable_inverse"]
 
@@ -672,8 +672,8 @@ def run_experiment(
     dict
         The summary written to ``summary.json`` (JSON-safe: non-finite numbers are None).
     """
-    from . import paper_figures
-    from .experiment_report import claims, render_report
+    from clpc.experiment import figures as paper_figures
+    from clpc.experiment.report import claims, render_report
 
     t_start = time.perf_counter()
     out = Path(out_dir)

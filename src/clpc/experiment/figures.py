@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from .experiment import CommandResult, Identification
+    from clpc.experiment.run import CommandResult, Identification
 
 __all__ = ["write_figures"]
 
@@ -90,7 +90,7 @@ def _per_cluster(ax: Axes, ident: Identification, values: np.ndarray, label: str
 
 def fig_command(path: Path, result: CommandResult, dpi: int) -> str:
     """Fig. 5: the position command (ramp with saturation) [rad]."""
-    from .experiment import LOG_SAMPLE_TIME
+    from clpc.experiment.run import LOG_SAMPLE_TIME
 
     fig = _figure()
     ax = fig.add_subplot()
@@ -138,7 +138,7 @@ def fig_parameter(path: Path, result: CommandResult, index: int, number: int, dp
 
 
 def _time(n: int) -> np.ndarray:
-    from .experiment import SAMPLE_TIME
+    from clpc.experiment.run import SAMPLE_TIME
 
     return np.arange(n) * SAMPLE_TIME
 

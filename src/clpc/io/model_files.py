@@ -45,10 +45,10 @@ from typing import Any
 
 import numpy as np
 
-from .data import DataError
-from .io import DataFileNotFoundError
-from .model import LinearModel, ModelError
-from .regressors import Structure
+from clpc.data import DataError
+from clpc.io.tables import DataFileNotFoundError
+from clpc.model import LinearModel, ModelError
+from clpc.model.structure import Structure
 
 __all__ = [
     "FORMAT",
@@ -133,7 +133,7 @@ def model_to_dict(model: LinearModel) -> dict[str, Any]:
     ModelFileError
         ``theta``, ``c`` or ``dt`` are not finite.
     """
-    from . import __version__
+    from clpc._version import __version__
 
     s = model.structure
     dt = float(model.dt)

@@ -48,7 +48,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from .data import DataError, IOData
+from clpc.data import DataError, IOData
 
 __all__ = [
     "DataFileNotFoundError",

@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from .model import LinearModel
-from .regressors import Structure
+from clpc.model import LinearModel
+from clpc.model.structure import Structure
 
 __all__ = ["Convergence", "Trace"]
 

@@ -1,0 +1,5 @@
+"""The ``clpc`` command line (click)."""
+
+from clpc.cli.commands import cli, main
+
+__all__ = ["cli", "main"]
