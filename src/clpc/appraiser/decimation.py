@@ -1,0 +1,69 @@
+"""Decimation to the appraiser's sample time: one anti-alias filter, carried across chunks.
+
+The filter is a causal 4th-order Butterworth at 0.8 of the new Nyquist frequency, started
+at rest at the first sample (no offset transient); the kept samples are ``0, f, 2f, ...``
+of the whole record, whatever the chunking.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+__all__ = ["Decimator", "decimate", "decimation_filter"]
+
+
+def decimation_filter(factor: int) -> np.ndarray:
+    """Second-order sections of the anti-alias filter for ``factor`` (>= 2)."""
+    return signal.butter(4, 0.8 / factor, output="sos")
+
+
+class Decimator:
+    """Filter and keep every ``factor``-th sample of a record fed in chunks.
+
+    Parameters
+    ----------
+    factor : int
+        Decimation factor (``sample_time / data_sample_time``), >= 1.
+    """
+
+    def __init__(self, factor: int) -> None:
+        self.factor = int(factor)
+        self.zi: np.ndarray | None = None  # filter state, (sections, 2, channels)
+        self.phase = 0  # samples fed so far, modulo factor
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """Decimate the next chunk ``x`` (T, channels); returns the kept samples."""
+        f = self.factor
+        if f == 1 or x.shape[0] == 0:
+            return x
+        sos = decimation_filter(f)
+        if self.zi is None:  # start at rest at the first sample
+            self.zi = signal.sosfilt_zi(sos)[:, :, None] * x[0][None, None, :]
+        filtered, self.zi = signal.sosfilt(sos, x, axis=0, zi=self.zi)
+        first = (-self.phase) % f
+        self.phase = (self.phase + x.shape[0]) % f
+        return filtered[first::f]
+
+
+def decimate(x: Any, factor: int) -> np.ndarray:
+    """Decimate a whole 1-D or 2-D signal at once, exactly as :class:`clpc.CLPC` does.
+
+    Parameters
+    ----------
+    x : array_like, shape (T,) or (T, channels)
+        Signal logged at the fast rate.
+    factor : int
+        Decimation factor.
+
+    Returns
+    -------
+    ndarray, shape (ceil(T / factor),) or (ceil(T / factor), channels)
+    """
+    arr = np.asarray(x, dtype=np.float64)
+    flat = arr.ndim == 1
+    cols = arr[:, None] if flat else arr
+    out = Decimator(factor)(cols).copy()
+    return out[:, 0] if flat else out

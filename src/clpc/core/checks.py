@@ -1,0 +1,69 @@
+"""Argument checks shared by every public entry point (one message style).
+
+Messages read "what must hold; what was given; how to fix". Booleans are never numbers here
+(``True`` is refused where an int or a float is expected).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["check_bool", "check_choice", "check_int", "check_nonnegative", "check_positive"]
+
+
+def check_int(value: Any, name: str, low: int = 0, high: int | None = None) -> int:
+    """``value`` as an int in ``[low, high]``; ``ValueError`` naming ``name`` otherwise."""
+    span = f"[{low}, {'inf' if high is None else high}]"
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an int in the range {span}; got {value!r}.")
+    if value < low or (high is not None and value > high):
+        raise ValueError(f"{name} must be an int in the range {span}; got {value}.")
+    return int(value)
+
+
+def _number(value: Any, name: str, what: str) -> float:
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise ValueError(f"{name} must be {what}; got {value!r}.")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {what}; got {value!r}.") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be {what}; got {value!r}.")
+    return v
+
+
+def check_positive(value: Any, name: str, unit: str = "") -> float:
+    """``value`` as a finite float > 0 (``unit`` names it in the message, e.g. ``"s"``)."""
+    what = "a finite number > 0" + (f" [{unit}]" if unit else "")
+    v = _number(value, name, what)
+    if v <= 0:
+        raise ValueError(f"{name} must be {what}; got {value!r}.")
+    return v
+
+
+def check_nonnegative(value: Any, name: str, unit: str = "") -> float:
+    """``value`` as a finite float >= 0."""
+    what = "a finite number >= 0" + (f" [{unit}]" if unit else "")
+    v = _number(value, name, what)
+    if v < 0:
+        raise ValueError(f"{name} must be {what}; got {value!r}.")
+    return v
+
+
+def check_bool(value: Any, name: str) -> bool:
+    """``value`` as a bool; strings such as ``"no"`` are refused (they are truthy)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False; got {value!r}.")
+    return bool(value)
+
+
+def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``choices``."""
+    if not isinstance(value, str) or value not in choices:
+        listed = ", ".join(repr(c) for c in choices)
+        raise ValueError(f"{name} must be one of {listed}; got {value!r}.")
+    return value

@@ -1,0 +1,116 @@
+"""One source, two ways to run it: plain Python, or compiled by numba.
+
+Every estimator rule and every kernel loop is written once, as a plain Python function in
+numba's subset, and marked with :func:`kernel`. The module keeps the plain function, so
+calling it runs Python (the ``"python"`` engine: for debugging, coverage and a reference).
+:func:`compiled` returns its numba twin: the same code object with its globals copied and
+every marked function it calls replaced by that function's twin, compiled on first call
+and cached on disk. No rule exists twice; the engines differ only in who runs the code.
+
+numba caches a compiled function by its own source file only; a twin also depends on the
+files of the functions it calls. The cache stamp of every marked function is therefore
+the digest of all files that hold marked functions, so editing a rule invalidates every
+kernel that inlines it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import types
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+__all__ = ["compiled", "kernel", "numba_available"]
+
+_MARKED: dict[int, Callable[..., Any]] = {}
+_TWINS: dict[int, Any] = {}
+_FILES: set[str] = set()
+
+
+def numba_available() -> bool:
+    """Whether numba can be imported (it is a core dependency; this guards odd installs)."""
+    return importlib.util.find_spec("numba") is not None
+
+
+def kernel(fn: F) -> F:
+    """Mark ``fn`` as part of the compiled engine; the plain function is returned unchanged."""
+    _MARKED[id(fn)] = fn
+    _FILES.add(fn.__code__.co_filename)
+    return fn
+
+
+def compiled(fn: Callable[..., Any]) -> Any:
+    """The numba twin of a :func:`kernel` function (built once, compiled on first call).
+
+    Parameters
+    ----------
+    fn : callable
+        A function marked with :func:`kernel`.
+
+    Returns
+    -------
+    numba dispatcher
+        Runs ``fn``'s code with every marked callee replaced by its own twin.
+    """
+    key = id(fn)
+    if key not in _MARKED:
+        raise ValueError(f"{fn.__qualname__} is not marked with clpc.core.jit.kernel.")
+    if key in _TWINS:
+        return _TWINS[key]
+    import numba
+
+    _install_stamp()
+    scope = dict(fn.__globals__)
+    twin = types.FunctionType(fn.__code__, scope, fn.__name__, fn.__defaults__, fn.__closure__)
+    twin.__qualname__ = fn.__qualname__
+    twin.__module__ = fn.__module__
+    twin.__doc__ = fn.__doc__
+    dispatcher = numba.njit(cache=True, nogil=True, error_model="numpy")(twin)
+    _TWINS[key] = dispatcher  # before the callees: recursion through the call graph ends here
+    for name, value in list(scope.items()):
+        if callable(value) and id(value) in _MARKED:
+            scope[name] = compiled(value)
+    return dispatcher
+
+
+def _engine_digest() -> str:
+    digest = hashlib.sha256()
+    for path in sorted(_FILES):
+        digest.update(path.encode())
+        digest.update(Path(path).read_bytes())
+    return digest.hexdigest()
+
+
+_STAMP_INSTALLED = False
+
+
+def _install_stamp() -> None:
+    """Make numba's cache stamp of engine files the digest of all engine files."""
+    global _STAMP_INSTALLED
+    if _STAMP_INSTALLED:
+        return
+    _STAMP_INSTALLED = True
+    try:
+        from numba.core import caching
+    except ImportError:  # pragma: no cover - numba without the caching module
+        return
+    impl = getattr(caching, "CacheImpl", None)
+    mixin = getattr(caching, "_SourceFileBackedLocatorMixin", None)
+    if impl is None or mixin is None:  # pragma: no cover - numba internals moved
+        return  # numba's own stamp (the function's file) still works, only less strictly
+
+    def stamp(self: Any) -> Any:
+        if self._py_file in _FILES:
+            return _engine_digest()
+        return super(type(self), self).get_source_stamp()
+
+    extra = [
+        type(f"Engine{cls.__name__}", (cls,), {"get_source_stamp": stamp})
+        for cls in impl._locator_classes
+        if issubclass(cls, mixin)
+    ]
+    impl._locator_classes = [*extra, *impl._locator_classes]

@@ -1,0 +1,128 @@
+"""Polynomial helpers, written once: theta to monic form, and the Schur-Cohn stability test.
+
+Plain Python in numba's subset (see :mod:`clpc.core.jit`): the model calls them as they
+are, the CLPC kernel compiles them into its loop, :func:`monic_many` and
+:func:`stable_many` run them compiled over whole traces.
+
+Conventions (paper eq. 17, ``y^T a + u^T b = r``): ``theta = [a_0..a_na, b_0..b_nb, ...]``
+(one ``b`` block per input, or a single block for the paper's paired MIMO). The monic
+form is ``A(z) = 1 + a_1/a_0 z^-1 + ...`` and ``B(z) = -(b_0 z^-nk + b_1 z^-(nk+1) + ...)/a_0``
+(the sign eq. 34 drops), so ``scipy.signal.lfilter(B, A, u)`` simulates the model.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from clpc.core.jit import compiled, kernel
+
+__all__ = ["monic", "monic_many", "schur_stable", "stable_many"]
+
+
+@kernel
+def schur_stable(den: np.ndarray, work: np.ndarray) -> bool:
+    """Whether every root of ``den[0] z^n + ... + den[n]`` lies strictly inside the unit circle.
+
+    The Schur-Cohn (Levinson) recursion: for ``m = n .. 1`` the reflection coefficient
+    ``k = a_m / a_0`` must satisfy ``|k| < 1``, then ``a_i <- (a_i - k a_{m-i}) / (1 - k^2)``.
+    ``O(n^2)``, no eigenvalue problem. ``work`` has at least ``len(den)`` entries.
+    """
+    n = den.shape[0]
+    for i in range(n):
+        work[i] = den[i]
+    for m in range(n - 1, 0, -1):
+        k = work[m] / work[0]
+        if not abs(k) < 1.0:  # also catches NaN
+            return False
+        scale = 1.0 - k * k
+        for i in range(m // 2 + 1):  # a_i and a_{m-i} together
+            lo = work[i]
+            hi = work[m - i]
+            work[i] = (lo - k * hi) / scale
+            work[m - i] = (hi - k * lo) / scale
+    return True
+
+
+@kernel
+def monic(
+    theta: np.ndarray,
+    na: int,
+    nb: int,
+    nk: int,
+    paired_input: int,
+    den: np.ndarray,
+    num: np.ndarray,
+) -> None:
+    """Fill the monic ``den`` (na + 1,) and ``num`` (n_inputs, nk + nb + 1) of one equation.
+
+    ``paired_input >= 0``: the paper's paired MIMO, the single ``b`` block drives that input;
+    ``-1``: one ``b`` block per input (SISO, MISO). ``theta[0]`` must be nonzero.
+    """
+    a0 = theta[0]
+    for k in range(na + 1):
+        den[k] = theta[k] / a0
+    for i in range(num.shape[0]):
+        for k in range(num.shape[1]):
+            num[i, k] = 0.0
+    n_blocks = (theta.shape[0] - na - 1) // (nb + 1)
+    for blk in range(n_blocks):
+        target = paired_input if paired_input >= 0 else blk
+        for k in range(nb + 1):
+            num[target, nk + k] = -theta[na + 1 + blk * (nb + 1) + k] / a0
+
+
+@kernel
+def _monic_rows(
+    theta: np.ndarray, na: int, nb: int, nk: int, paired: bool, den: np.ndarray, num: np.ndarray
+) -> None:
+    for r in range(theta.shape[0]):
+        for e in range(theta.shape[1]):
+            monic(theta[r, e], na, nb, nk, e if paired else -1, den[r, e], num[r, e])
+
+
+@kernel
+def _stable_rows(den: np.ndarray, out: np.ndarray) -> None:
+    work = np.empty(den.shape[1])
+    for r in range(den.shape[0]):
+        out[r] = schur_stable(den[r], work)
+
+
+def monic_many(
+    theta: np.ndarray, na: int, nb: int, nk: int, n_inputs: int, paired: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`monic` over many equations (compiled).
+
+    Parameters
+    ----------
+    theta : ndarray, shape (..., E, p)
+        Parameter vectors (``a0`` nonzero); ``E`` equations (outputs) per row.
+    na, nb, nk : int
+        The structure.
+    n_inputs : int
+        Inputs of the model.
+    paired : bool
+        The paper's paired MIMO (equation ``e`` drives input ``e``).
+
+    Returns
+    -------
+    den : ndarray, shape (..., E, na + 1)
+    num : ndarray, shape (..., E, n_inputs, nk + nb + 1)
+    """
+    theta = np.ascontiguousarray(theta, dtype=np.float64)
+    lead = theta.shape[:-2]
+    flat = theta.reshape(-1, *theta.shape[-2:])
+    den = np.empty((*flat.shape[:2], na + 1))
+    num = np.empty((*flat.shape[:2], n_inputs, nk + nb + 1))
+    if flat.shape[0]:
+        compiled(_monic_rows)(flat, na, nb, nk, paired, den, num)
+    return den.reshape(*lead, *den.shape[1:]), num.reshape(*lead, *num.shape[1:])
+
+
+def stable_many(den: np.ndarray) -> np.ndarray:
+    """:func:`schur_stable` over the leading axes of ``den`` (..., n + 1) (compiled)."""
+    den = np.ascontiguousarray(den, dtype=np.float64)
+    flat = den.reshape(-1, den.shape[-1])
+    out = np.zeros(flat.shape[0], dtype=np.bool_)
+    if flat.shape[0]:
+        compiled(_stable_rows)(flat, out)
+    return out.reshape(den.shape[:-1])
