@@ -1,4 +1,10 @@
-"""The compiled CLPC engine against the numpy engine, and its small eigen-solver."""
+"""The CLPC engine against an independent per-window SVD reference; its eigen-solver.
+
+The reference (``tests/lpc_reference.py``) builds each window's lag matrix, centers it and
+takes its SVD, with array formulas for the rules; the engine merges block statistics and
+runs :mod:`clpc.core.rules` in compiled loops. Both engines of the one source (compiled and
+plain Python) are checked against it.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +13,9 @@ import pytest
 
 import clpc
 from clpc import CLPC, DataError, Trace
-from clpc.appraiser import facade as appraiser_module
+from clpc.appraiser import engine as engine_module
 from clpc.core.small_eigh import sym_eig
+from lpc_reference import reference_clpc
 
 pytest.importorskip("numba")
 
@@ -67,63 +74,70 @@ def _record(n, seed, n_in=1, n_out=1, offset=0.0):
     return u + offset, y + offset
 
 
-def _compare(a: Trace, b: Trace) -> None:
-    assert len(a) == len(b) > 0
-    np.testing.assert_array_equal(a.index, b.index)
-    np.testing.assert_array_equal(a.rows, b.rows)
-    np.testing.assert_array_equal(a.not_enough_data, b.not_enough_data)
+def _compare(a: Trace, ref: dict) -> None:
+    assert len(a) == len(ref["rows"]) > 0
+    np.testing.assert_array_equal(a.rows, ref["rows"])
+    np.testing.assert_array_equal(a.not_enough_data, ref["not_enough"])
     usable = ~a.not_enough_data
-    assert set(a.arrays) == set(b.arrays)
     for key in FLOAT_KEYS:
-        x, y = a.arrays[key][usable], b.arrays[key][usable]
-        scale = np.abs(x).max() if x.size else 1.0
+        x, y = a.arrays[key][usable], ref[key][usable]
+        scale = np.abs(y).max() if y.size else 1.0
         np.testing.assert_allclose(x, y, rtol=1e-10, atol=1e-10 * scale, err_msg=key)
-    top = a.arrays["lambda_max"][usable].max()
-    for key in EIGEN_KEYS:
-        x, y = a.arrays[key][usable], b.arrays[key][usable]
-        np.testing.assert_allclose(x, y, rtol=0, atol=1e-12 * top, err_msg=key)
-    var_a, var_b = a.arrays["noise_variance"][usable], b.arrays["noise_variance"][usable]
+    top = ref["eigenvalues"][usable].max()
+    np.testing.assert_allclose(
+        a.arrays["eigenvalues"][usable], ref["eigenvalues"][usable], rtol=0, atol=1e-12 * top
+    )
+    lam = a.arrays["eigenvalues"]
+    np.testing.assert_array_equal(a.arrays["D"], lam[..., -1] - lam[..., 0])
+    var_a, var_b = a.arrays["noise_variance"][usable], ref["noise_variance"][usable]
     np.testing.assert_allclose(var_a, var_b, rtol=0, atol=1e-12 * top / a.rows[usable].min())
-    for t in (a, b):  # J is the paper's eq. 22 at the solution
-        n = t.rows[:, None]
-        # floored at 1e3 eps of the largest per-row variance (rounding, not noise)
-        floor = 1e3 * np.finfo(float).eps * t.arrays["lambda_max"][:, :, None] / n[:, :, None]
-        var = np.maximum(t.arrays["noise_variance"], floor[..., 0])
-        var = np.maximum(var, np.finfo(float).tiny)
-        np.testing.assert_allclose(t.arrays["J"], 0.5 * n * (np.log(var) + 1), rtol=1e-13)
+    # J is the paper's eq. 22 at the solution, the variance floored at 1e3 eps of the largest
+    # per-row variance (rounding, not noise)
+    n = a.rows[:, None]
+    floor = 1e3 * np.finfo(float).eps * a.arrays["lambda_max"] / n
+    var = np.maximum(np.maximum(a.arrays["noise_variance"], floor), np.finfo(float).tiny)
+    np.testing.assert_allclose(a.arrays["J"], 0.5 * n * (np.log(var) + 1), rtol=1e-13)
     for key in FLAG_KEYS:
-        np.testing.assert_array_equal(a.arrays[key][usable], b.arrays[key][usable], key)
+        np.testing.assert_array_equal(a.arrays[key][usable], ref[key][usable], key)
 
 
-@pytest.mark.parametrize(
-    ("kwargs", "n_in", "n_out"),
-    [
-        ({}, 1, 1),
-        ({"method": "paper"}, 1, 1),
-        ({"noise_ratio": 3.0}, 1, 1),
-        ({"method": "paper", "noise_cov": [1, 1.1, 1.2, 2, 2.1, 2.2]}, 1, 1),
-        ({"noise_cov": np.diag([1, 1.1, 1.2, 2, 2.1, 2.2]) + 0.05}, 1, 1),
-        ({"gate": True, "window_size": 60, "cluster_size": 7}, 1, 1),
-        ({"na": 3, "nb": 1, "nk": 2, "window_size": 24, "cluster_size": 12}, 1, 1),
-        ({"cluster_size": 1, "window_size": 40}, 1, 1),
-        ({"mimo": "miso"}, 2, 2),
-        ({"mimo": "paired", "method": "paper"}, 2, 2),
-    ],
-)
-def test_compiled_engine_equals_numpy_engine(kwargs, n_in, n_out):
-    # the numpy engine's prefix-sum path (cluster_size=1) cancels about eps * (offset /
-    # spread)^2 of lambda_min; the compiled engine merges exactly. Both are checked against an
-    # exact per-window SVD with offsets in test_clpc.py; here the offset is left out for it.
-    offset = 0.0 if kwargs.get("cluster_size") == 1 else 1e3
-    u, y = _record(3000, seed=3, n_in=n_in, n_out=n_out, offset=offset)
+PARITY_CASES = [
+    ({}, 1, 1),
+    ({"method": "paper"}, 1, 1),
+    ({"noise_ratio": 3.0}, 1, 1),
+    ({"method": "paper", "noise_cov": [1, 1.1, 1.2, 2, 2.1, 2.2]}, 1, 1),
+    ({"noise_cov": np.diag([1, 1.1, 1.2, 2, 2.1, 2.2]) + 0.05}, 1, 1),
+    ({"gate": True, "window_size": 60, "cluster_size": 7}, 1, 1),
+    ({"na": 3, "nb": 1, "nk": 2, "window_size": 24, "cluster_size": 12}, 1, 1),
+    ({"cluster_size": 1, "window_size": 40}, 1, 1),
+    ({"mimo": "miso"}, 2, 2),
+    ({"mimo": "paired", "method": "paper"}, 2, 2),
+]
+
+
+@pytest.mark.parametrize(("kwargs", "n_in", "n_out"), PARITY_CASES)
+def test_engine_equals_per_window_svd_reference(kwargs, n_in, n_out):
+    u, y = _record(3000, seed=3, n_in=n_in, n_out=n_out, offset=1e3)
     settings = {"parameters_size": 3, "window_size": 201, "cluster_size": 12, **kwargs}
+    appraiser = CLPC(**settings, engine="compiled")
+    _compare(appraiser.run(u, y), reference_clpc(u, y, appraiser))
+
+
+@pytest.mark.parametrize(("kwargs", "n_in", "n_out"), PARITY_CASES[::3])
+def test_python_engine_runs_the_same_source(kwargs, n_in, n_out):
+    # the uncompiled engine: the very same functions, run by the interpreter (coverage)
+    u, y = _record(700, seed=4, n_in=n_in, n_out=n_out, offset=1e3)
+    settings = {"parameters_size": 3, "window_size": 101, "cluster_size": 12, **kwargs}
+    appraiser = CLPC(**settings, engine="python")
+    slow = appraiser.run(u, y)
+    _compare(slow, reference_clpc(u, y, appraiser))
     fast = CLPC(**settings, engine="compiled").run(u, y)
-    ref = CLPC(**settings, engine="numpy").run(u, y)
-    _compare(fast, ref)
+    for key in ("theta", "eigenvalues", "c", "J", "accepted"):
+        np.testing.assert_allclose(slow.arrays[key], fast.arrays[key], rtol=1e-13, atol=0)
 
 
 @pytest.mark.parametrize("kind", ["ramp", "constant", "zeros"])
-def test_engines_agree_on_poorly_excited_and_degenerate_windows(kind):
+def test_engine_agrees_with_reference_on_poorly_excited_and_degenerate_windows(kind):
     rng = np.random.default_rng(5)
     u = rng.standard_normal(2000)
     if kind == "ramp":
@@ -136,13 +150,14 @@ def test_engines_agree_on_poorly_excited_and_degenerate_windows(kind):
         2000
     )
     for gate in (False, True):
-        fast = CLPC(3, 101, 12, gate=gate, engine="compiled").run(u, y)
-        ref = CLPC(3, 101, 12, gate=gate, engine="numpy").run(u, y)
-        np.testing.assert_array_equal(fast.degenerate, ref.degenerate)
-        np.testing.assert_array_equal(fast.accepted, ref.accepted)
+        appraiser = CLPC(3, 101, 12, gate=gate, engine="compiled")
+        fast = appraiser.run(u, y)
+        ref = reference_clpc(u, y, appraiser)
+        np.testing.assert_array_equal(fast.degenerate, ref["degenerate"][:, 0])
+        np.testing.assert_array_equal(fast.accepted, ref["accepted"][:, 0])
         for key in ("theta", "den", "D", "J", "c"):
             assert np.all(np.isfinite(fast.arrays[key])), key
-        np.testing.assert_allclose(fast.theta, ref.theta, atol=1e-9)
+        np.testing.assert_allclose(fast.theta, ref["theta"][:, 0], atol=1e-9)
     if kind == "zeros":
         assert fast.degenerate.all() and not fast.has_model.any()
 
@@ -184,17 +199,19 @@ def test_step_rejects_non_finite_scalars_with_the_sample_index():
 
 
 def test_engine_choice_and_errors(monkeypatch):
-    assert CLPC(engine="numpy").engine == "numpy"
-    monkeypatch.setenv("CLPC_ENGINE", "numpy")
-    assert CLPC().engine == "numpy"
+    assert CLPC(engine="python").engine == "python"
+    monkeypatch.setenv("CLPC_ENGINE", "python")
+    assert CLPC().engine == "python"
     assert CLPC(engine="compiled").engine == "compiled"  # an explicit choice wins
     monkeypatch.setenv("CLPC_ENGINE", "fast")
     with pytest.raises(ValueError, match="CLPC_ENGINE"):
         CLPC()
     with pytest.raises(ValueError, match="engine must be"):
         CLPC(engine="gpu")
-    monkeypatch.setattr(appraiser_module, "numba_available", lambda: False)
+    with pytest.raises(ValueError, match="engine must be"):
+        CLPC(engine="numpy")  # the numpy engine is gone: one source, two ways to run it
+    monkeypatch.setattr(engine_module, "numba_available", lambda: False)
     with pytest.raises(ValueError, match="needs numba"):
         CLPC(engine="compiled")
     monkeypatch.delenv("CLPC_ENGINE")
-    assert CLPC().engine == "numpy"  # auto without numba
+    assert CLPC().engine == "python"  # auto without numba

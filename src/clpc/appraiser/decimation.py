@@ -12,7 +12,33 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-__all__ = ["Decimator", "decimate", "decimation_filter"]
+from clpc.data import DataError
+
+__all__ = ["Decimator", "decimate", "decimation_factor", "decimation_filter"]
+
+#: relative tolerance of "an integer multiple of the data's sample time"
+FACTOR_RTOL = 1e-9
+
+
+def decimation_factor(target: float | None, data_dt: float | None) -> int:
+    """The integer factor from the data's sample time to the target one (1: none).
+
+    Raises
+    ------
+    DataError
+        When ``target`` is not an integer multiple of ``data_dt``.
+    """
+    if target is None or data_dt is None:
+        return 1
+    ratio = target / data_dt
+    factor = round(ratio)
+    if factor < 1 or abs(ratio - factor) > FACTOR_RTOL * max(ratio, 1.0):
+        raise DataError(
+            f"sample_time={target:g} s must be an integer multiple of the data's sample "
+            f"time {data_dt:g} s (ratio {ratio:g}); resample the data or choose sample_time "
+            "accordingly."
+        )
+    return factor
 
 
 def decimation_filter(factor: int) -> np.ndarray:

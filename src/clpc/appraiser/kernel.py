@@ -1,68 +1,172 @@
-r"""The compiled CLPC engine: block statistics, window merge and LPC solve in one kernel.
+r"""The CLPC engine: block statistics, exact window merge, LPC solve and FSM output.
 
-The numpy engine (:mod:`clpc.sliding` + :func:`clpc.solve.solve_scatter`) is vectorised over
-windows but pays a LAPACK call (~4 us) per 6x6 matrix, two of them with the robust default,
-plus numpy's per-call overhead on small arrays. This module does the same computation for
-one window after the other inside numba-compiled loops (:mod:`clpc.small_eigh` for the
-eigenproblems), with no temporaries: about 9-10x the plain per-window reference instead of
-~4.5x (``benchmarks/bench_clpc.py``). It is used when numba is installed (``CLPC(engine=...)``).
+One source for both engines (:mod:`clpc.core.jit`): ``"compiled"`` runs these loops through
+numba, ``"python"`` runs them as they are (slow; for debugging and coverage). The rules of
+the solution are :mod:`clpc.core.rules`, the eigen-solver :mod:`clpc.core.small_eigh`, the
+monic form and the stability test :mod:`clpc.core.polynomials`: nothing here restates them.
 
-The arithmetic is the numpy engine's, not its bit pattern (different eigen-solver, merge
-order): the two agree to ~1e-12 (``tests/test_window_kernel.py``). Within this engine, a
-window's numbers depend only on its own rows, never on how a record was chunked, so
+A window's numbers depend only on its own rows, never on how a record was chunked, so
 ``run``, ``push`` in any chunks and ``step`` give bit-identical results.
 
-Per window ``[s, e)`` (``e = C j``, ``s = max(0, e - W)``) the pieces are the full blocks
-``[l C, (l + 1) C)`` inside it (statistics computed once per block, two-pass) and, when
-``s`` is not a block boundary, the tail of block ``s // C`` (its last ``e - s`` mod ``C``
-rows, computed per window); they are merged with the formula of Chan, Golub and LeVeque
-(:mod:`clpc.sliding`), so offsets and long records lose no digits.
+Windows (section V; ``docs/clpc.md``): update ``j`` closes after lag row ``e = C j`` and
+uses rows ``[s, e)``, ``s = max(0, e - W)``: the window grows until it holds ``W`` rows,
+then slides. Cut the lag rows into blocks ``[l C, (l + 1) C)``; a window is::
+
+    tail of the block holding s (its last rows)  +  the full blocks up to e
+    \____________ computed per window _________/    \___ once per block __/
+
+Each piece is summarised by its count, mean and centered scatter (two-pass), and pieces
+are merged with the formula of Chan, Golub and LeVeque::
+
+    n = sum n_k,   mean = sum n_k mean_k / n,
+    A = sum A_k + sum n_k (mean_k - mean)(mean_k - mean)^T
+
+Every term is centered, so offsets (positions around 1e4 rad) and long records lose no
+digits.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
-import numba
 import numpy as np
 
-from clpc.core import small_eigh
-from clpc.lpc.solve import ROUNDING_VARIANCE_FACTOR
+from clpc.core.jit import kernel
+from clpc.core.polynomials import monic, schur_stable
+from clpc.core.rules import (
+    CHANNEL_SCALES,
+    NO_TRANSFORM,
+    SolveSettings,
+    accepts,
+    channel_scales,
+    eig_ratio,
+    index_j,
+    is_determined,
+    likelihood_variance,
+    solve_from_eig,
+    solved_matrix,
+)
+from clpc.core.small_eigh import sym_eig
 
-_ROUNDING_VARIANCE = ROUNDING_VARIANCE_FACTOR * float(np.finfo(np.float64).eps)
-
-__all__ = ["solve_windows"]
-
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-
-_tred2 = _jit(small_eigh._tred2)
-_tql2 = _jit(small_eigh._tql2)
-
-
-@_jit
-def _sym_eig(a, d, v, e, vectors):  # pragma: no cover - compiled
-    """:func:`clpc.small_eigh.sym_eig` with the compiled pieces."""
-    n = a.shape[0]
-    for i in range(n):
-        for j in range(n):
-            v[i, j] = a[i, j]
-    _tred2(v, d, e, n)
-    return _tql2(v, d, e, n, vectors)
+__all__ = ["FsmOutput", "FsmSettings", "FsmState", "Solved", "WindowPlan", "fsm_output"]
 
 
-# transform modes of the solved problem T^T A T
-NO_TRANSFORM, CHANNEL_SCALES, FIXED_TRANSFORM = 0, 1, 2
-# layout of the float options vector
-OPT_MIN_A0, OPT_RATIO, OPT_ZERO_TOL, OPT_MIN_OUTPUT = 0, 1, 2, 3
+class WindowPlan(NamedTuple):
+    """Where the lag rows come from, fixed per record.
 
-
-@_jit
-def _piece_stats(samples, chan, lag, first, lo, hi, z, mean, scat):  # pragma: no cover
-    """Mean and centered scatter (two-pass) of lag rows ``lo .. hi - 1`` of one equation.
-
-    Row ``r`` is the lag vector whose newest sample is ``samples[first + r]``; its entry
-    ``a`` is ``samples[first + r - lag[a], chan[a]]`` (built on the fly into ``z``).
+    Column ``a`` of equation ``e`` is ``samples[k - lag[e, a], chan[e, a]]`` for the row
+    whose newest sample is ``samples[k]``.
     """
+
+    chan: np.ndarray  #: (E, p) int64
+    lag: np.ndarray  #: (E, p) int64
+    col_channel: np.ndarray  #: (p,) int64, channel block of each column (0 = output)
+    transform: np.ndarray  #: (p, p), T of a FIXED_TRANSFORM solve (else unused)
+    window: int  #: W, lag rows per window
+    cluster: int  #: C, lag rows between updates
+    min_rows: int  #: windows with fewer rows are "not enough data": no solve runs
+
+
+class Solved(NamedTuple):
+    """Per-window solutions, shapes (count, E, ...) (``n_rows``: (count,))."""
+
+    theta: np.ndarray
+    eigenvalues: np.ndarray
+    c: np.ndarray
+    noise_variance: np.ndarray
+    separation: np.ndarray
+    a0_weight: np.ndarray
+    n_null: np.ndarray
+    n_input_relations: np.ndarray
+    degenerate: np.ndarray
+    n_rows: np.ndarray
+
+
+class FsmSettings(NamedTuple):
+    """The FSM output's settings."""
+
+    min_rows: int
+    gate: bool
+    separation_tol: float
+    na: int
+    nb: int
+    nk: int
+    paired: bool
+
+
+class FsmState(NamedTuple):
+    """The carried part of the FSM state (updated in place)."""
+
+    last_theta: np.ndarray  #: (E, p)
+    last_c: np.ndarray  #: (E,)
+    has_model: np.ndarray  #: (E,) bool
+
+
+class FsmOutput(NamedTuple):
+    """What the FSM outputs per update, shapes (count, E, ...) (``not_enough``: (count,))."""
+
+    theta: np.ndarray
+    c: np.ndarray
+    accepted: np.ndarray
+    has_model: np.ndarray
+    determined: np.ndarray
+    not_enough: np.ndarray
+    den: np.ndarray
+    num: np.ndarray
+    stable: np.ndarray
+    lambda_min: np.ndarray
+    lambda_max: np.ndarray
+    D: np.ndarray
+    eig_ratio: np.ndarray
+    J: np.ndarray
+
+
+class Work(NamedTuple):
+    """Work space of :func:`solve_one`, allocated once per batch of windows."""
+
+    mat: np.ndarray  #: (p, p)
+    tmat: np.ndarray  #: (p, p)
+    vecs: np.ndarray  #: (p, p)
+    vals: np.ndarray  #: (p,)
+    raw: np.ndarray  #: (p,)
+    ework: np.ndarray  #: (p,)
+    phi: np.ndarray  #: (p,)
+    scales: np.ndarray  #: (p,)
+
+
+@kernel
+def new_work(p: int) -> Work:
+    """Work space for problems of size ``p``."""
+    return Work(
+        np.empty((p, p)),
+        np.empty((p, p)),
+        np.empty((p, p)),
+        np.empty(p),
+        np.empty(p),
+        np.empty(p),
+        np.empty(p),
+        np.ones(p),
+    )
+
+
+@kernel
+def piece_stats(
+    samples: np.ndarray,
+    chan: np.ndarray,
+    lag: np.ndarray,
+    first: int,
+    rows: tuple[int, int],
+    z: np.ndarray,
+    out: tuple[np.ndarray, np.ndarray],
+) -> None:
+    """Mean and centered scatter (two-pass) of lag rows ``rows[0] .. rows[1] - 1``.
+
+    Row ``r`` is the lag vector whose newest sample is ``samples[first + r]``, built on the
+    fly into ``z``; ``out = (mean (p,), scat (p, p))``.
+    """
+    lo, hi = rows
+    mean, scat = out
     p = mean.shape[0]
     n = hi - lo
     for a in range(p):
@@ -85,14 +189,22 @@ def _piece_stats(samples, chan, lag, first, lo, hi, z, mean, scat):  # pragma: n
             scat[b, a] = scat[a, b]
 
 
-@_jit
-def _merge(b_mean, b_scat, lo, hi, size, t_size, t_mean, t_scat, dev, mean, scat):
-    """Merge blocks ``lo .. hi - 1`` (``size`` rows each) and a tail piece into one window.
+@kernel
+def merge(
+    blocks: tuple[np.ndarray, np.ndarray, int, int, int],
+    tail: tuple[int, np.ndarray, np.ndarray],
+    dev: np.ndarray,
+    out: tuple[np.ndarray, np.ndarray],
+) -> float:
+    """Merge full blocks and a tail piece into one window (Chan, Golub and LeVeque).
 
-    The formula of Chan, Golub and LeVeque: ``mean = sum n_k mean_k / n`` and ``A = sum A_k
-    + sum n_k (mean_k - mean)(mean_k - mean)^T``; the tail (``t_size`` rows, skipped when 0)
-    is the first piece. ``dev`` is work space of shape (pieces, p). Returns ``n``.
-    """  # pragma: no cover - compiled
+    ``blocks = (b_mean (n, p), b_scat (n, p, p), lo, hi, size)``: blocks ``lo .. hi - 1``
+    of ``size`` rows; ``tail = (t_size, t_mean, t_scat)`` (skipped when ``t_size`` is 0);
+    ``dev`` work space (pieces, p); ``out = (mean, scat)``. Returns the row count.
+    """
+    b_mean, b_scat, lo, hi, size = blocks
+    t_size, t_mean, t_scat = tail
+    mean, scat = out
     p = mean.shape[0]
     total = t_size + size * (hi - lo)
     for a in range(p):
@@ -119,443 +231,178 @@ def _merge(b_mean, b_scat, lo, hi, size, t_size, t_mean, t_scat, dev, mean, scat
     return float(total)
 
 
-@_jit
-def _solve_one(
-    scat,
-    mean,
-    n_rows,
-    col_channel,
-    n_channels,
-    n_out_cols,
-    transform_mode,
-    transform,
-    robust,
-    opts,
-    work,
-    out_theta,
-    out_vals,
-):  # pragma: no cover - compiled
-    """LPC of one window (see :func:`clpc.solve.solve_scatter`, same rules).
+@kernel
+def solve_one(
+    scat: np.ndarray,
+    mean: np.ndarray,
+    n_rows: float,
+    plan: WindowPlan,
+    s: SolveSettings,
+    work: Work,
+    out: tuple[np.ndarray, np.ndarray],
+) -> tuple[float, float, float, float, int, int, bool]:
+    """LPC of one window: the solved problem, its eigenpairs, then :func:`solve_from_eig`.
 
-    Returns ``(c, noise_variance, separation, a0_weight, n_null, n_input, degenerate)``.
+    ``out = (theta (p,), eigenvalues (p,))``; ``work`` from :func:`new_work`. A
+    non-finite window is degenerate.
     """
+    theta, eigenvalues = out
     p = scat.shape[0]
-    mat, vals, vecs, ework, tmat, raw, phi, scales = work
-    n_safe = max(n_rows, 1.0)
+    mat, tmat, vecs, vals, raw, ework, phi, scales = work
     finite = True
     for a in range(p):
         for b in range(p):
             if not math.isfinite(scat[a, b]):
                 finite = False
-    # ---- the solved problem T^T A T
-    if transform_mode == CHANNEL_SCALES:
-        for ch in range(n_channels):
-            acc = 0.0
-            cnt = 0
-            for a in range(p):
-                if col_channel[a] == ch:
-                    acc += scat[a, a]
-                    cnt += 1
-            std = math.sqrt(max(acc / cnt, 0.0) / n_safe)
-            for a in range(p):
-                if col_channel[a] == ch:
-                    scales[a] = std if std > 0 else 1.0
-        for a in range(p):
-            for b in range(p):
-                tmat[a, b] = 0.0
-            tmat[a, a] = 1.0 / scales[a]
-        for a in range(p):
-            for b in range(p):
-                mat[a, b] = scat[a, b] / (scales[a] * scales[b])
-    elif transform_mode == FIXED_TRANSFORM:
-        for a in range(p):
-            for b in range(p):
-                tmat[a, b] = transform[a, b]
-        # mat = T^T A T, symmetrised
-        for a in range(p):
-            for b in range(p):
-                acc = 0.0
-                for k in range(p):
-                    for m in range(p):
-                        acc += tmat[k, a] * scat[k, m] * tmat[m, b]
-                mat[a, b] = acc
-        for a in range(p):
-            for b in range(a):
-                sym = 0.5 * (mat[a, b] + mat[b, a])
-                mat[a, b] = sym
-                mat[b, a] = sym
-    else:
-        for a in range(p):
-            for b in range(p):
-                mat[a, b] = scat[a, b]
-    ok = finite and _sym_eig(mat, vals, vecs, ework, True)
-    if transform_mode == NO_TRANSFORM:
+    if s.transform_mode == CHANNEL_SCALES:
+        channel_scales(scat, n_rows, plan.col_channel, s.n_channels, scales)
+    solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
+    ok = finite and sym_eig(mat, vals, vecs, ework, True)
+    if ok and s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself
         for a in range(p):
             raw[a] = vals[a]
     elif ok:
-        ok = _sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
+        ok = sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
     if not ok:
         for a in range(p):
-            out_theta[a] = 0.0
-            out_vals[a] = 0.0
+            theta[a] = 0.0
+            eigenvalues[a] = 0.0
         return 0.0, 0.0, 1.0, 0.0, 1, 0, True
-    # ---- degenerate: nothing varies, or a channel is constant (relative to its own size)
-    top = max(raw[p - 1], 0.0)
-    degenerate = not top > 0
-    for ch in range(n_channels):
-        var = -1.0
-        size = 0.0
-        for a in range(p):
-            if col_channel[a] == ch:
-                var = max(var, scat[a, a])
-                size = max(size, abs(mean[a]))
-        if var <= 1e-28 * max(top, 1e-300) or var / n_safe <= (1e-12 * size) ** 2:
-            degenerate = True
-    # ---- the solution in the solved problem
-    min_out = opts[OPT_MIN_OUTPUT]
-    if not robust:
-        for a in range(p):
-            phi[a] = vecs[a, 0]
-        n_null = 1
-        wy = 0.0
-        for a in range(n_out_cols):
-            wy += vecs[a, 0] ** 2
-        n_input = 1 if wy < min_out else 0
-        separation = _ratio(vals[0], vals[1] if p > 1 else vals[0])
-    else:
-        ratio = opts[OPT_RATIO]
-        if not ratio > 0:  # Marchenko-Pastur edge ratio, at most 4
-            x = math.sqrt(p / n_safe)
-            ratio = ((1 + x) / max(1 - x, 1e-12)) ** 2 if x < 1 else math.inf
-            ratio = min(ratio, 4.0)
-        first = -1
-        for i in range(p):
-            if abs(vecs[0, i]) >= opts[OPT_MIN_A0]:
-                first = i
-                break
-        if first < 0:  # no candidate: the eigenvector with the largest y(n) component
-            best = -1.0
-            for i in range(p):
-                if abs(vecs[0, i]) > best:
-                    best = abs(vecs[0, i])
-                    first = i
-        lam_s = max(vals[first], opts[OPT_ZERO_TOL] * max(vals[p - 1], 0.0))
-        last = p - 1
-        for i in range(first + 1, p):
-            if not max(vals[i], 0.0) <= ratio * lam_s:
-                last = i - 1
-                break
-        for a in range(p):
-            phi[a] = 0.0
-        n_input = 0
-        for i in range(last + 1):
-            w = vecs[0, i]
-            for a in range(p):
-                phi[a] += vecs[a, i] * w
-            wy = 0.0
-            for a in range(n_out_cols):
-                wy += vecs[a, i] ** 2
-            if wy < min_out:
-                n_input += 1
-        n_null = last + 1
-        separation = 1.0 if last + 1 >= p else _ratio(lam_s, vals[last + 1])
-    norm = 0.0
-    for a in range(p):
-        norm += phi[a] * phi[a]
-    norm = math.sqrt(norm)
-    a0_weight = abs(phi[0]) / (norm if norm > 0 else 1.0)
-    # ---- theta = T phi, unit norm, a0 > 0 (else the first nonzero entry > 0)
-    for a in range(p):
-        if transform_mode == NO_TRANSFORM:
-            out_theta[a] = phi[a]
-        else:
-            acc = 0.0
-            for b in range(p):
-                acc += tmat[a, b] * phi[b]
-            out_theta[a] = acc
-    norm = 0.0
-    for a in range(p):
-        norm += out_theta[a] * out_theta[a]
-    norm = math.sqrt(norm)
-    sign = 1.0
-    for a in range(p):
-        out_theta[a] = out_theta[a] / norm if norm > 0 else 0.0
-    for a in range(p):
-        if abs(out_theta[a]) > 1e-14:
-            sign = -1.0 if out_theta[a] < 0 else 1.0
-            break
-    for a in range(p):
-        out_theta[a] = 0.0 if degenerate else sign * out_theta[a]
-        out_vals[a] = max(raw[a], 0.0)
-    c = 0.0
-    quad = 0.0
-    for a in range(p):
-        c += mean[a] * out_theta[a]
-        acc = 0.0
-        for b in range(p):
-            acc += scat[a, b] * out_theta[b]
-        quad += out_theta[a] * acc
-    noise_variance = max(quad, 0.0) / n_safe
-    if degenerate:
-        a0_weight = 0.0
-    return c, noise_variance, separation, a0_weight, n_null, n_input, degenerate
+    return solve_from_eig(
+        scat, mean, n_rows, (vals, vecs, raw), tmat, s, plan.col_channel, (phi, theta, eigenvalues)
+    )
 
 
-@_jit
-def _ratio(num, den):  # pragma: no cover - compiled
-    num = max(num, 0.0)
-    den = max(den, 0.0)
-    if not den > 0:
-        return 1.0
-    return min(num / den, 1.0)
-
-
-@_jit
+@kernel
 def solve_windows(
-    samples,
-    first_row,
-    col_chan,
-    col_lag,
-    j0,
-    count,
-    window,
-    cluster,
-    col_channel,
-    n_channels,
-    n_out_cols,
-    transform_mode,
-    transform,
-    robust,
-    opts,
-    theta,
-    eigenvalues,
-    c,
-    noise_variance,
-    separation,
-    a0_weight,
-    n_null,
-    n_input,
-    degenerate,
-    n_rows_out,
-):  # pragma: no cover - compiled
-    """Solve windows ``j = j0 .. j0 + count - 1`` of every equation; fill the outputs.
+    samples: np.ndarray,
+    first_row: int,
+    windows: tuple[int, int],
+    plan: WindowPlan,
+    s: SolveSettings,
+    out: Solved,
+) -> None:
+    """Solve windows ``j0 .. j0 + count - 1`` (``windows = (j0, count)``) of every equation.
 
-    Parameters
-    ----------
-    samples : ndarray, shape (n, channels)
-        Samples; lag row ``r`` (absolute) has its newest sample at ``samples[r - first_row]``.
-    first_row, j0, count, window, cluster : int
-    col_chan, col_lag : ndarray of int64, shape (E, p)
-        Column ``a`` of equation ``e`` is ``samples[k - col_lag[e, a], col_chan[e, a]]``.
-    col_channel : ndarray of int64, shape (p,)
-        Channel block (0 = output, 1.. = inputs) of each column, for the scaling.
-    n_channels, n_out_cols, transform_mode : int
-    transform : ndarray, shape (p, p)
-        ``T`` for ``FIXED_TRANSFORM`` (else unused).
-    robust : bool
-    opts : ndarray, shape (4,)
-        ``min_a0_weight``, ``degeneracy_ratio`` (<= 0: Marchenko-Pastur), ``zero_tol``,
-        ``min_output_weight``.
-    theta, eigenvalues : ndarray, shape (count, E, p)
-    c, noise_variance, separation, a0_weight : ndarray, shape (count, E)
-    n_null, n_input : ndarray of int64, shape (count, E)
-    degenerate : ndarray of bool, shape (count, E)
-    n_rows_out : ndarray of int64, shape (count,)
+    ``samples`` (n, channels): lag row ``r`` (absolute) has its newest sample at
+    ``samples[r - first_row]``. Windows with fewer than ``plan.min_rows`` rows are not
+    solved (their outputs are zero and flagged degenerate).
     """
-    n_eq, p = col_chan.shape
+    j0, count = windows
+    n_eq, p = plan.chan.shape
+    window, cluster = plan.window, plan.cluster
     first = -first_row
-    # blocks touched by the windows: from the one holding the first window's start
-    s_first = max(0, cluster * j0 - window)
-    b_lo = s_first // cluster
-    n_blocks = j0 + count - 1 - b_lo  # block j-1 is the newest of window j
-    max_pieces = window // cluster + 2
+    b_lo = max(0, cluster * j0 - window) // cluster  # the block holding the first start
+    n_blocks = j0 + count - 1 - b_lo  # block j - 1 is the newest of window j
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
-    dev = np.empty((max_pieces, p))
+    dev = np.empty((window // cluster + 2, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
     z = np.empty(p)
-    work = (
-        np.empty((p, p)),
-        np.empty(p),
-        np.empty((p, p)),
-        np.empty(p),
-        np.empty((p, p)),
-        np.empty(p),
-        np.empty(p),
-        np.empty(p),
-    )
+    work = new_work(p)
     for eq in range(n_eq):
-        chan = col_chan[eq]
-        lag = col_lag[eq]
+        chan = plan.chan[eq]
+        lag = plan.lag[eq]
         for b in range(n_blocks):
             lo = (b_lo + b) * cluster
-            _piece_stats(samples, chan, lag, first, lo, lo + cluster, z, b_mean[b], b_scat[b])
+            piece_stats(samples, chan, lag, first, (lo, lo + cluster), z, (b_mean[b], b_scat[b]))
         for w in range(count):
             j = j0 + w
             e = cluster * j
-            s = max(0, e - window)
-            full_lo = -(-s // cluster)
-            t_size = full_lo * cluster - s  # the tail of the block holding s, if any
+            start = max(0, e - window)
+            out.n_rows[w] = e - start
+            if e - start < plan.min_rows:
+                for a in range(p):
+                    out.theta[w, eq, a] = 0.0
+                    out.eigenvalues[w, eq, a] = 0.0
+                out.c[w, eq] = 0.0
+                out.noise_variance[w, eq] = 0.0
+                out.separation[w, eq] = 1.0
+                out.a0_weight[w, eq] = 0.0
+                out.n_null[w, eq] = 0
+                out.n_input_relations[w, eq] = 0
+                out.degenerate[w, eq] = True
+                continue
+            full_lo = -(-start // cluster)
+            t_size = full_lo * cluster - start  # the tail of the block holding start
             if t_size > 0:
-                _piece_stats(samples, chan, lag, first, s, full_lo * cluster, z, t_mean, t_scat)
-            n_w = _merge(
-                b_mean,
-                b_scat,
-                full_lo - b_lo,
-                j - b_lo,
-                cluster,
-                t_size,
-                t_mean,
-                t_scat,
+                piece_stats(
+                    samples, chan, lag, first, (start, full_lo * cluster), z, (t_mean, t_scat)
+                )
+            n_w = merge(
+                (b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster),
+                (t_size, t_mean, t_scat),
                 dev,
-                mean,
-                scat,
+                (mean, scat),
             )
-            out = _solve_one(
-                scat,
-                mean,
-                n_w,
-                col_channel,
-                n_channels,
-                n_out_cols,
-                transform_mode,
-                transform,
-                robust,
-                opts,
-                work,
-                theta[w, eq],
-                eigenvalues[w, eq],
+            res = solve_one(
+                scat, mean, n_w, plan, s, work, (out.theta[w, eq], out.eigenvalues[w, eq])
             )
-            c[w, eq] = out[0]
-            noise_variance[w, eq] = out[1]
-            separation[w, eq] = out[2]
-            a0_weight[w, eq] = out[3]
-            n_null[w, eq] = out[4]
-            n_input[w, eq] = out[5]
-            degenerate[w, eq] = out[6]
-            n_rows_out[w] = e - s
+            out.c[w, eq] = res[0]
+            out.noise_variance[w, eq] = res[1]
+            out.separation[w, eq] = res[2]
+            out.a0_weight[w, eq] = res[3]
+            out.n_null[w, eq] = res[4]
+            out.n_input_relations[w, eq] = res[5]
+            out.degenerate[w, eq] = res[6]
 
 
-@_jit
-def finish_updates(
-    theta_est,
-    c_est,
-    eigenvalues,
-    noise_variance,
-    separation,
-    a0_weight,
-    n_null,
-    n_input,
-    degenerate,
-    n_rows,
-    min_rows,
-    gate,
-    min_a0_weight,
-    separation_tol,
-    na,
-    nb,
-    nk,
-    paired,
-    last_theta,
-    last_c,
-    has_model_state,
-    theta,
-    c,
-    accepted,
-    has_model,
-    determined,
-    not_enough,
-    den,
-    num,
-    stable,
-    lambda_min,
-    lambda_max,
-    D,
-    eig_ratio,
-    J,
-):  # pragma: no cover - compiled
-    """The FSM output of solved windows, in time order (``CLPC._finish_numpy``, compiled).
+@kernel
+def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput) -> None:
+    """The FSM output of solved windows, in time order.
 
-    Accepts or holds each estimate, updates the carried state (``last_theta``, ``last_c``,
-    ``has_model_state``, in place), and fills the monic forms, the Schur stability flag and
-    the per-window statistics (see :func:`clpc.lpc.solution_info`). Shapes as in
-    :func:`solve_windows`; ``den`` (count, E, na + 1), ``num`` (count, E, inputs, nk + nb
-    + 1).
+    Accepts or holds each estimate (:func:`clpc.core.rules.accepts`), updates the carried
+    ``state`` in place, and fills the monic forms, the Schur stability flag and the
+    per-window statistics (``D = lambda_max - lambda_min``, ``J`` of eq. 22).
     """
-    count, n_eq, p = theta_est.shape
-    n_blocks = (p - na - 1) // (nb + 1)
-    tiny = np.finfo(np.float64).tiny
-    work = np.empty(na + 1)
+    count, n_eq, p = solved.theta.shape
+    work = np.empty(fs.na + 1)
     for w in range(count):
-        few = n_rows[w] < min_rows
-        not_enough[w] = few
+        n_rows = solved.n_rows[w]
+        few = n_rows < fs.min_rows
+        out.not_enough[w] = few
         for e in range(n_eq):
-            lo = eigenvalues[w, e, 0]
-            hi = eigenvalues[w, e, p - 1]
-            lambda_min[w, e] = lo
-            lambda_max[w, e] = hi
-            D[w, e] = hi - lo
-            eig_ratio[w, e] = lo / hi if hi > 0 else 1.0
-            floor = _ROUNDING_VARIANCE * max(hi, 0.0) / max(n_rows[w], 1)
-            var = max(noise_variance[w, e], floor, tiny)
-            J[w, e] = 0.5 * n_rows[w] * (math.log(var) + 1.0)
-            det = (
-                n_null[w, e] == 1
-                and n_input[w, e] == 0
-                and separation[w, e] <= separation_tol
-                and not degenerate[w, e]
+            lo = solved.eigenvalues[w, e, 0]
+            hi = solved.eigenvalues[w, e, p - 1]
+            out.lambda_min[w, e] = lo
+            out.lambda_max[w, e] = hi
+            out.D[w, e] = hi - lo
+            out.eig_ratio[w, e] = eig_ratio(lo, hi)
+            var = likelihood_variance(solved.noise_variance[w, e], hi, n_rows)
+            out.J[w, e] = index_j(var, n_rows)
+            det = is_determined(
+                solved.n_null[w, e],
+                solved.n_input_relations[w, e],
+                solved.separation[w, e],
+                solved.degenerate[w, e],
+                fs.separation_tol,
             )
-            determined[w, e] = det
-            ok = not few and not degenerate[w, e] and a0_weight[w, e] >= min_a0_weight
-            if gate:
-                ok = ok and det
-            accepted[w, e] = ok
+            out.determined[w, e] = det
+            ok = accepts(few, solved.degenerate[w, e], solved.a0_weight[w, e], fs.gate, det)
+            out.accepted[w, e] = ok
             if ok:
                 for a in range(p):
-                    last_theta[e, a] = theta_est[w, e, a]
-                last_c[e] = c_est[w, e]
-                has_model_state[e] = True
+                    state.last_theta[e, a] = solved.theta[w, e, a]
+                state.last_c[e] = solved.c[w, e]
+                state.has_model[e] = True
             for a in range(p):
-                theta[w, e, a] = last_theta[e, a]
-            c[w, e] = last_c[e]
-            model = has_model_state[e]
-            has_model[w, e] = model
-            for i in range(num.shape[2]):
-                for k in range(num.shape[3]):
-                    num[w, e, i, k] = 0.0
-            if model:
-                a0 = last_theta[e, 0]
-                for k in range(na + 1):
-                    den[w, e, k] = last_theta[e, k] / a0
-                for i in range(n_blocks):
-                    target = e if paired else i
-                    for k in range(nb + 1):
-                        num[w, e, target, nk + k] = -last_theta[e, na + 1 + i * (nb + 1) + k] / a0
-                stable[w, e] = _schur_stable(den[w, e], work)
+                out.theta[w, e, a] = state.last_theta[e, a]
+            out.c[w, e] = state.last_c[e]
+            out.has_model[w, e] = state.has_model[e]
+            if state.has_model[e]:
+                target = e if fs.paired else -1
+                monic(
+                    state.last_theta[e], fs.na, fs.nb, fs.nk, target, out.den[w, e], out.num[w, e]
+                )
+                out.stable[w, e] = schur_stable(out.den[w, e], work)
             else:
-                den[w, e, 0] = 1.0
-                for k in range(1, na + 1):
-                    den[w, e, k] = 0.0
-                stable[w, e] = False
-
-
-@_jit
-def _schur_stable(den, a):  # pragma: no cover - compiled
-    """:func:`clpc.appraiser.schur_stable` for one polynomial (``a``: work space)."""
-    n = den.shape[0]
-    for i in range(n):
-        a[i] = den[i]
-    for m in range(n - 1, 0, -1):
-        k = a[m] / a[0]
-        if not abs(k) < 1.0:
-            return False
-        scale = 1.0 - k * k
-        for i in range(m // 2 + 1):  # a_i and a_{m-i} together
-            lo = a[i]
-            hi = a[m - i]
-            a[i] = (lo - k * hi) / scale
-            a[m - i] = (hi - k * lo) / scale
-    return True
+                out.den[w, e, 0] = 1.0
+                for k in range(1, fs.na + 1):
+                    out.den[w, e, k] = 0.0
+                for i in range(out.num.shape[2]):
+                    for k in range(out.num.shape[3]):
+                        out.num[w, e, i, k] = 0.0
+                out.stable[w, e] = False

@@ -38,7 +38,7 @@ def _number(value: Any, name: str, what: str) -> float:
 
 def check_positive(value: Any, name: str, unit: str = "") -> float:
     """``value`` as a finite float > 0 (``unit`` names it in the message, e.g. ``"s"``)."""
-    what = "a finite number > 0" + (f" [{unit}]" if unit else "")
+    what = "a positive finite number" + (f" [{unit}]" if unit else "")
     v = _number(value, name, what)
     if v <= 0:
         raise ValueError(f"{name} must be {what}; got {value!r}.")

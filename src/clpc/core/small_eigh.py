@@ -2,15 +2,15 @@
 
 CLPC solves one 6x6 (``p x p``) eigenproblem per window. A LAPACK call costs about 4 us for
 such a matrix, mostly call overhead; the same algorithm written as loops and compiled with
-numba (:mod:`clpc.window_kernel`) costs well under 1 us and runs inside the per-window
+numba (:mod:`clpc.appraiser.kernel`) costs well under 1 us and runs inside the per-window
 kernel without leaving compiled code.
 
 The algorithm is the classic pair used by EISPACK (``tred2``/``tql2``) and its public-domain
 Java translation JAMA: Householder reduction to tridiagonal form accumulating the
 transformations, then the implicit QL iteration with Wilkinson-like shifts. It is backward
 stable: eigenvalues carry an absolute error of a few ``eps * ||A||``, like LAPACK's
-``dsyev``. The functions below are plain Python (slow, but importable without numba); the
-kernel module compiles them.
+``dsyev``. The functions below are plain Python in numba's subset; :mod:`clpc.core.jit` compiles
+them into the CLPC kernel.
 """
 
 from __future__ import annotations
@@ -19,12 +19,15 @@ import math
 
 import numpy as np
 
+from clpc.core.jit import kernel
+
 __all__ = ["sym_eig"]
 
 _EPS = 2.0**-52
 _MAX_QL_ITERATIONS = 60  # per eigenvalue; a few are needed in practice
 
 
+@kernel
 def sym_eig(a: np.ndarray, d: np.ndarray, v: np.ndarray, e: np.ndarray, vectors: bool) -> bool:
     """Eigenvalues (ascending) and, optionally, eigenvectors of a symmetric matrix.
 
@@ -56,6 +59,7 @@ def sym_eig(a: np.ndarray, d: np.ndarray, v: np.ndarray, e: np.ndarray, vectors:
     return _tql2(v, d, e, n, vectors)
 
 
+@kernel
 def _tred2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int) -> None:
     """Householder tridiagonalisation of ``v`` in place (``v`` becomes the transformation)."""
     for j in range(n):
@@ -130,6 +134,7 @@ def _tred2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int) -> None:
     e[0] = 0.0
 
 
+@kernel
 def _tql2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int, vectors: bool) -> bool:
     """Implicit QL iteration on the tridiagonal ``(d, e)``; rotations applied to ``v``."""
     for i in range(1, n):

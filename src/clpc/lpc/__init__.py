@@ -6,7 +6,7 @@ least-squares baseline, ``order`` order and delay selection, ``noise`` noise var
 """
 
 from clpc.lpc.arx import ARX, simulate_arx
-from clpc.lpc.estimator import LPC, fit_info, lpc_solve, solution_info, structure_blocks
+from clpc.lpc.estimator import LPC, fit_info, lpc_solve, structure_blocks
 from clpc.lpc.noise import NoiseEstimate, estimate_noise_variances
 from clpc.lpc.order import DelaySelection, OrderSelection, select_delay, select_order
 from clpc.lpc.solve import RobustRule
@@ -24,6 +24,5 @@ __all__ = [
     "select_delay",
     "select_order",
     "simulate_arx",
-    "solution_info",
     "structure_blocks",
 ]

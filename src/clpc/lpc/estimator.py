@@ -16,16 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core import rules
 from clpc.data import DataError, IOData, as_iodata
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from clpc.lpc.solve import (
-    RobustRule,
-    SolveResult,
-    index_j,
-    likelihood_variance,
-    log_likelihood,
-    solve_scatter,
-)
+from clpc.lpc.solve import RobustRule, SolveResult, solve_scatter
 from clpc.model import LinearModel
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
@@ -82,66 +76,48 @@ def lpc_solve(
 
 
 def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str, np.ndarray]:
-    """Statistics of a solve as plain arrays (one entry per equation or window).
+    """Statistics of a solve as plain arrays (one entry per equation).
 
     Keys: ``eigenvalues``, ``lambda_min``, ``lambda_max``, ``D`` (``lambda_max -
     lambda_min``, the paper's degree of linearity), ``eig_ratio`` (``lambda_min /
     lambda_max``, scale-free), ``separation``, ``c``, ``noise_variance``,
     ``log_likelihood``, ``J`` (eq. 22), ``n_rows``, ``n_null``, ``n_input_relations``,
-    ``degenerate``, ``determined``.
+    ``degenerate``, ``determined``. Each number comes from :mod:`clpc.core.rules`, the
+    functions the CLPC kernel compiles.
     """
-    return solution_info(
-        res.eigenvalues,
-        res.c,
-        res.noise_variance,
-        res.n_null,
-        res.n_input_relations,
-        res.separation,
-        res.degenerate,
-        n_rows,
-        rule,
-    )
-
-
-def solution_info(
-    eigenvalues: np.ndarray,
-    c: np.ndarray,
-    noise_variance: np.ndarray,
-    n_null: np.ndarray,
-    n_input_relations: np.ndarray,
-    separation: np.ndarray,
-    degenerate: np.ndarray,
-    n_rows: np.ndarray,
-    rule: RobustRule,
-) -> dict[str, np.ndarray]:
-    """:func:`fit_info` from the solution's arrays (any leading shape ``s``).
-
-    ``eigenvalues`` has shape ``s + (p,)``, the others ``s`` (``n_rows`` broadcasts).
-    """
-    vals = eigenvalues
-    lam_min, lam_max = vals[..., 0], vals[..., -1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(lam_max > 0, lam_min / np.where(lam_max > 0, lam_max, 1.0), 1.0)
-    ll_var = likelihood_variance(noise_variance, lam_max, np.asarray(n_rows))
-    determined = (
-        (n_null == 1) & (n_input_relations == 0) & (separation <= rule.separation) & ~degenerate
-    )
+    vals = res.eigenvalues
+    n = np.asarray(n_rows, dtype=np.float64) * np.ones(vals.shape[0])
+    lam_min, lam_max = vals[:, 0].copy(), vals[:, -1].copy()
+    ll_var = [
+        rules.likelihood_variance(float(v), float(hi), float(m))
+        for v, hi, m in zip(res.noise_variance, lam_max, n, strict=True)
+    ]
+    determined = [
+        rules.is_determined(int(a), int(b), float(c), bool(d), rule.separation)
+        for a, b, c, d in zip(
+            res.n_null, res.n_input_relations, res.separation, res.degenerate, strict=True
+        )
+    ]
     return {
         "eigenvalues": vals,
         "lambda_min": lam_min,
         "lambda_max": lam_max,
         "D": lam_max - lam_min,
-        "eig_ratio": ratio,
-        "separation": separation,
-        "c": c,
-        "noise_variance": noise_variance,
-        "log_likelihood": log_likelihood(ll_var, n_rows),
-        "J": index_j(ll_var, n_rows),
+        "eig_ratio": np.array(
+            [rules.eig_ratio(lo, hi) for lo, hi in zip(lam_min, lam_max, strict=True)]
+        ),
+        "separation": res.separation,
+        "c": res.c,
+        "noise_variance": res.noise_variance,
+        "log_likelihood": np.array(
+            [rules.log_likelihood(v, m) for v, m in zip(ll_var, n, strict=True)]
+        ),
+        "J": np.array([rules.index_j(v, m) for v, m in zip(ll_var, n, strict=True)]),
         "n_rows": np.asarray(n_rows),
-        "n_null": n_null,
-        "n_input_relations": n_input_relations,
-        "degenerate": degenerate,
-        "determined": determined,
+        "n_null": res.n_null,
+        "n_input_relations": res.n_input_relations,
+        "degenerate": res.degenerate,
+        "determined": np.array(determined, dtype=bool),
     }
 
 
