@@ -29,24 +29,22 @@ from __future__ import annotations
 
 import math
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
-from clpc.appraiser import kernel
+from clpc.appraiser import fsm
 from clpc.appraiser import state as state_io
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator, decimation_factor
-from clpc.appraiser.engine import Engine, resolve_engine, settings_for, window_plan
+from clpc.appraiser.engine import resolve_engine
 from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
 from clpc.appraiser.trace import Trace
-from clpc.appraiser.updates import KernelSetup, TraceLabels, empty_arrays, solve_updates
+from clpc.appraiser.updates import KernelSetup
 from clpc.core.checks import check_choice, check_int, check_positive
 from clpc.core.rules import RobustRule
 from clpc.data import DataError, IOData, as_iodata
-from clpc.lpc.regressors import miso_regressor
-from clpc.model.structure import Structure, check_mode, default_mode
+from clpc.model.structure import Structure
 
 __all__ = ["CLPC"]
 
@@ -190,94 +188,11 @@ class CLPC:
             return np.empty((0, self.structure.n_params()))
         rows_total = max(self._n_seen - self.structure.max_lag, 0)
         first = max(rows_total - self.window_size, 0)
-        rows = self._lag_rows(self._buffer.since(first))
+        rows = fsm.lag_rows(self, self._buffer.since(first))
         rows.setflags(write=False)
         return rows[0] if rows.shape[0] == 1 else rows
 
     # ================================================================= configuration
-    def _mode(self) -> str:
-        assert self._n_in is not None and self._n_out is not None
-        mode = self.mimo or default_mode(self._n_in, self._n_out)
-        check_mode(mode, self._n_in, self._n_out)
-        return mode
-
-    def _n_blocks(self) -> int:
-        assert self._n_in is not None
-        return self._n_in if self._mode() == "miso" else 1
-
-    def _p(self) -> int:
-        return self.structure.n_params(self._n_blocks())
-
-    def _min_rows(self) -> int:
-        return self.min_rows if self.min_rows is not None else 2 * self._p()
-
-    def _noise(self) -> np.ndarray | None:
-        if self.noise_cov is not None:
-            return self.noise_cov
-        if self.noise_ratio is None:
-            return None
-        s = self.structure
-        ratio = float(self.noise_ratio)
-        if not np.isfinite(ratio) or ratio <= 0:
-            raise ValueError(f"noise_ratio must be > 0; got {self.noise_ratio!r}.")
-        return np.concatenate([np.ones(s.na + 1), np.full(self._n_blocks() * (s.nb + 1), ratio)])
-
-    def _time_step(self) -> float:
-        """Seconds per (decimated) sample: sample_time, else the data's, else 1."""
-        return self.sample_time or self._record_dt or self.data_sample_time or 1.0
-
-    def _init_channels(self, n_in: int, n_out: int, names: Any = None) -> None:
-        if self._n_in is None:
-            self._n_in, self._n_out = n_in, n_out
-            self._mode()  # validates
-            self._buffer = SampleBuffer(n_in + n_out)
-            p = self._p()
-            self._last_theta = np.zeros((n_out, p))
-            self._last_c = np.zeros(n_out)
-            self._has_model = np.zeros(n_out, dtype=bool)
-            if names is not None:
-                self._names = names
-        elif (n_in, n_out) != (self._n_in, self._n_out):
-            raise DataError(
-                f"the appraiser was fed {self._n_in} input(s) and {self._n_out} output(s); "
-                f"this chunk has {n_in} and {n_out}. Call reset() to start a new record."
-            )
-
-    def _kernel_setup(self) -> KernelSetup:
-        """The kernel's plan, settings and engine (fixed per record)."""
-        if self._setup is None:
-            assert self._n_in is not None and self._n_out is not None
-            s = self.structure
-            miso = self._mode() == "miso"
-            noise = self._noise()
-            sizes = (self.window_size, self.cluster_size, self._min_rows())
-            plan, n_channels = window_plan(s, (self._n_in, self._n_out, miso), sizes, noise)
-            self._setup = KernelSetup(
-                engine=Engine(self.engine),
-                plan=plan,
-                settings=settings_for(self.method, self.rule, noise, s.na, n_channels),
-                fsm=kernel.FsmSettings(
-                    self._min_rows(), self.gate, self.rule.separation, s.na, s.nb, s.nk, not miso
-                ),
-                n_inputs=self._n_in,
-            )
-        return self._setup
-
-    def _labels(self) -> TraceLabels:
-        n_in, n_out = self._n_in or 1, self._n_out or 1
-        names = self._names or (
-            tuple(f"u{i}" for i in range(n_in)) if n_in > 1 else ("u",),
-            tuple(f"y{i}" for i in range(n_out)) if n_out > 1 else ("y",),
-        )
-        return TraceLabels(
-            structure=self.structure,
-            n_inputs=n_in,
-            mode=self._mode() if self._n_in is not None else "siso",
-            sample_time=self._time_step(),
-            names=names,
-            meta={"gate": self.gate, "method": self.method},
-        )
-
     # ================================================================= streaming API
     def step(self, u_k: Any, y_k: Any) -> Trace:
         """Feed one sample; returns the update it produced (a trace of 0 or 1 rows).
@@ -314,10 +229,10 @@ class CLPC:
         self._buffer.pending.append(sample)
         self._n_seen += 1
         if not update:
-            return self._empty_trace()
+            return fsm.empty_trace(self)
         block = self._buffer.take_pending()
         self._n_seen -= block.shape[0]  # _consume counts them
-        return self._consume(block)
+        return fsm.consume(self, block)
 
     def push(self, u: Any, y: Any) -> Trace:
         """Feed a chunk of samples of any length.
@@ -342,16 +257,16 @@ class CLPC:
             )
         check_finite(u2, "u", self._n_seen)
         check_finite(y2, "y", self._n_seen)
-        self._init_channels(u2.shape[1], y2.shape[1])
+        fsm.init_channels(self, u2.shape[1], y2.shape[1])
         if self._decimator is None:
             self._decimator = Decimator(self._factor_for(None))
         total = self._updates_after(u2.shape[0])
         # the parts are written into the final arrays (no concatenation at the end)
-        out = Trace.allocate(self._empty_trace(), total) if total else self._empty_trace()
+        out = Trace.allocate(fsm.empty_trace(self), total) if total else fsm.empty_trace(self)
         done = 0
         for lo in range(0, u2.shape[0], self.chunk_samples):  # bounded working memory
             hi = lo + self.chunk_samples
-            part = self._consume(self._decimator(np.hstack([u2[lo:hi], y2[lo:hi]])))
+            part = fsm.consume(self, self._decimator(np.hstack([u2[lo:hi], y2[lo:hi]])))
             if total:
                 done = out.put(done, part)
         assert done == total, (done, total)
@@ -390,66 +305,18 @@ class CLPC:
             # plain arrays: validated by push, without IOData's defensive copy of the record
             u_arr, y_arr = as_columns(u, "u"), as_columns(y, "y")
             data_dt = None if dt is None else _seconds(dt, "dt")
-            self._init_channels(u_arr.shape[1], y_arr.shape[1])
+            fsm.init_channels(self, u_arr.shape[1], y_arr.shape[1])
         else:
             data = as_iodata(u, y, dt)
             u_arr, y_arr = data.u, data.y
             given_dt = isinstance(u, IOData) or dt is not None
             data_dt = data.dt if given_dt else None  # arrays without dt: at sample_time
             names = (data.input_names, data.output_names)
-            self._init_channels(data.n_inputs, data.n_outputs, names)
+            fsm.init_channels(self, data.n_inputs, data.n_outputs, names)
         self._decimator = Decimator(self._factor_for(data_dt))
         if self.sample_time is None and data_dt is not None:
             self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
         return self.push(u_arr, y_arr)
-
-    # ================================================================= updates
-    def _lag_rows(self, buf: np.ndarray) -> np.ndarray:
-        """Lag rows of every equation from decimated samples ``buf``: (E, n, p)."""
-        assert self._n_in is not None and self._n_out is not None
-        u, y = buf[:, : self._n_in], buf[:, self._n_in :]
-        if buf.shape[0] <= self.structure.max_lag:
-            return np.empty((self._n_out, 0, self._p()))
-        miso = self._mode() == "miso"
-        return np.stack(
-            [
-                miso_regressor(y[:, j], u if miso else u[:, j : j + 1], self.structure)
-                for j in range(self._n_out)
-            ]
-        )
-
-    def _consume(self, new: np.ndarray) -> Trace:
-        """Append decimated samples and compute the updates they complete."""
-        if new.shape[0] == 0:
-            return self._empty_trace()
-        buf = self._buffer
-        assert buf is not None and self._last_theta is not None
-        assert self._last_c is not None and self._has_model is not None
-        buf.append(new)
-        self._n_seen += new.shape[0]
-        s, c, w = self.structure, self.cluster_size, self.window_size
-        j_last = max(self._n_seen - s.max_lag, 0) // c
-        trace = self._empty_trace()
-        if j_last > self._j_done:
-            state = kernel.FsmState(self._last_theta, self._last_c, self._has_model)
-            threads = (self.n_jobs, self._executor().map if self.n_jobs > 1 else map)
-            parts = solve_updates(
-                self._kernel_setup(),
-                (buf.data, buf.start - s.max_lag),
-                (self._j_done + 1, j_last),
-                state,
-                threads,
-            )
-            labels = self._labels()
-            traces = []
-            for j0, count, arrays in parts:
-                index = s.max_lag + c * np.arange(j0, j0 + count) - 1
-                traces.append(labels.trace(index, arrays.pop("n_rows"), arrays))
-            trace = traces[0] if len(traces) == 1 else Trace.concat(traces)
-            self._j_done = j_last
-        # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
-        buf.drop_before(max(0, c * (self._j_done + 1) - w - c))
-        return trace
 
     def _executor(self) -> ThreadPoolExecutor:
         """A thread pool kept for the appraiser's lifetime (created on first use)."""
@@ -457,41 +324,10 @@ class CLPC:
             self._pool = ThreadPoolExecutor(self.n_jobs)
         return self._pool
 
-    def _empty_trace(self) -> Trace:
-        if self._empty is not None:
-            return self._empty
-        e = self._n_out or 1
-        p = self._p() if self._n_in is not None else self.structure.n_params()
-        arrays = empty_arrays(e, p, self.structure, self._n_in or 1)
-        z = np.zeros(0, dtype=np.int64)
-        empty = self._labels().trace(z, z, arrays)
-        if self._n_in is not None:
-            self._empty = empty
-        return empty
-
     # ================================================================= persistence
     def config(self) -> dict[str, Any]:
         """Constructor arguments (JSON-safe)."""
-        return {
-            "parameters_size": self.parameters_size,
-            "window_size": self.window_size,
-            "cluster_size": self.cluster_size,
-            "sample_time": self.sample_time,
-            "na": self.structure.na,
-            "nb": self.structure.nb,
-            "nk": self.structure.nk,
-            "method": self.method,
-            "mimo": self.mimo,
-            "noise_ratio": self.noise_ratio,
-            "noise_cov": None if self.noise_cov is None else self.noise_cov.tolist(),
-            "rule": asdict(self.rule),
-            "gate": self.gate,
-            "min_rows": self.min_rows,
-            "data_sample_time": self.data_sample_time,
-            "n_jobs": self.n_jobs,
-            "chunk_samples": self.chunk_samples,
-            "engine": self._engine_request,
-        }
+        return state_io.config_of(self)
 
     def state_dict(self) -> dict[str, Any]:
         """The FSM state and configuration as a JSON-safe dict (floats round-trip exactly)."""
@@ -500,7 +336,7 @@ class CLPC:
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> CLPC:
         """Rebuild an appraiser from :meth:`state_dict` output; it continues identically."""
-        return state_io.restore(cls, state)  # type: ignore[no-any-return]
+        return state_io.restore(cls, state)
 
     def save(self, path: str) -> None:
         """Write :meth:`state_dict` as JSON to ``path``."""
@@ -509,7 +345,7 @@ class CLPC:
     @classmethod
     def load(cls, path: str) -> CLPC:
         """Read an appraiser saved with :meth:`save`."""
-        return state_io.load(cls, path)  # type: ignore[no-any-return]
+        return state_io.load(cls, path)
 
     def __repr__(self) -> str:
         return (

@@ -7,6 +7,7 @@ seen), the last parameters, plus the decimation filter's state. Floats round-tri
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
@@ -15,7 +16,7 @@ from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator
 from clpc.core.rules import RobustRule
 
-__all__ = ["FORMAT", "VERSION", "load", "restore", "save", "snapshot"]
+__all__ = ["FORMAT", "VERSION", "config_of", "load", "restore", "save", "snapshot"]
 
 FORMAT = "clpc-appraiser-state"
 VERSION = 1
@@ -29,6 +30,30 @@ def _unarr(x: Any) -> np.ndarray | None:
     return None if x is None else np.asarray(x["data"], float).reshape(x["shape"])
 
 
+def config_of(a: Any) -> dict[str, Any]:
+    """The constructor arguments of appraiser ``a`` (JSON-safe)."""
+    return {
+        "parameters_size": a.parameters_size,
+        "window_size": a.window_size,
+        "cluster_size": a.cluster_size,
+        "sample_time": a.sample_time,
+        "na": a.structure.na,
+        "nb": a.structure.nb,
+        "nk": a.structure.nk,
+        "method": a.method,
+        "mimo": a.mimo,
+        "noise_ratio": a.noise_ratio,
+        "noise_cov": None if a.noise_cov is None else a.noise_cov.tolist(),
+        "rule": asdict(a.rule),
+        "gate": a.gate,
+        "min_rows": a.min_rows,
+        "data_sample_time": a.data_sample_time,
+        "n_jobs": a.n_jobs,
+        "chunk_samples": a.chunk_samples,
+        "engine": a._engine_request,
+    }
+
+
 def snapshot(a: Any) -> dict[str, Any]:
     """The state of appraiser ``a`` (see :meth:`clpc.CLPC.state_dict`)."""
     buf = a._buffer
@@ -38,7 +63,7 @@ def snapshot(a: Any) -> dict[str, Any]:
     return {
         "format": FORMAT,
         "version": VERSION,
-        "config": a.config(),
+        "config": config_of(a),
         "n_in": a._n_in,
         "n_out": a._n_out,
         "names": None if a._names is None else [list(n) for n in a._names],

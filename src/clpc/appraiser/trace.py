@@ -133,7 +133,7 @@ class Trace:
             raise ValueError("nothing to concatenate")
         first = traces[0] if like is None else like
         plain = ("index", "time", "rows", "not_enough_data")
-        kw = {f: np.concatenate([getattr(t, f) for t in traces]) for f in plain}
+        kw: dict[str, Any] = {f: np.concatenate([getattr(t, f) for t in traces]) for f in plain}
         arrays = {k: np.concatenate([t.arrays[k] for t in traces]) for k in first.arrays}
         rest = {
             f.name: getattr(first, f.name)
@@ -150,7 +150,9 @@ class Trace:
         at the end (which holds the parts and the result at once: twice the memory).
         """
         plain = ("index", "time", "rows", "not_enough_data")
-        kw = {f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in plain}
+        kw: dict[str, Any] = {
+            f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in plain
+        }
         arrays = {k: np.empty((n, *v.shape[1:]), v.dtype) for k, v in like.arrays.items()}
         rest = {
             f.name: getattr(like, f.name)
@@ -225,11 +227,11 @@ class Trace:
         (relative) since the previous update; convergence needs ``consecutive`` such
         updates in a row.
         """
-        acc = self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1)
+        acc = np.asarray(self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1))
         theta = self.arrays["theta"]
-        d = self.arrays["D"]
+        d: np.ndarray = self.arrays["D"]
         n = len(self)
-        quiet = np.zeros(n, dtype=bool)
+        quiet: np.ndarray = np.zeros(n, dtype=bool)
         if n > 1:
             dtheta = np.linalg.norm(theta[1:] - theta[:-1], axis=2).max(axis=1)
             scale = np.maximum(np.abs(d[1:]), np.finfo(float).tiny)
@@ -285,7 +287,7 @@ class Trace:
             With ``info["convergence"]``.
         """
         conv = convergence or self.convergence()
-        acc = self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1)
+        acc = np.asarray(self.arrays["accepted"].all(axis=1) & self.arrays["has_model"].all(axis=1))
         if conv.converged:
             sel = acc & (np.arange(len(self)) >= conv.update)
         elif allow_unconverged and acc.any():

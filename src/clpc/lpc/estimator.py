@@ -75,7 +75,7 @@ def lpc_solve(
     )
 
 
-def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str, np.ndarray]:
+def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str, Any]:
     """Statistics of a solve as plain arrays (one entry per equation).
 
     Keys: ``eigenvalues``, ``lambda_min``, ``lambda_max``, ``D`` (``lambda_max -

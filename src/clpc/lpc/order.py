@@ -126,18 +126,19 @@ def select_order(
         info = model.info
         n = int(info["n_rows"][0])
         n_free = (model.theta.shape[1] - 1 + 2) * model.n_outputs
-        ll = float(np.sum(info["log_likelihood"]))
+        loglik = float(np.sum(info["log_likelihood"]))
         rows.append(
             (
                 float(np.sum(info["J"])),
-                ll,
-                2 * n_free - 2 * ll,
-                n_free * np.log(n) - 2 * ll,
+                loglik,
+                2 * n_free - 2 * loglik,
+                n_free * np.log(n) - 2 * loglik,
                 float(np.sum(info["noise_variance"])),
                 n_free,
             )
         )
-    J, ll, aic, bic, var, n_par = (np.array(col) for col in zip(*rows, strict=True))
+    cols = [np.array(col) for col in zip(*rows, strict=True)]
+    J, ll, aic, bic, var, n_par = cols
     val_fit = None
     if criterion == "validation":
         val_fit = _validation_fits(data, base, orders, k, validation_fraction)

@@ -56,11 +56,11 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
         except ValueError:
             stable = False
-        msgs = (
+        notes = (
             "no fit statistics (an averaged or loaded model)",
             "the model is stable" if stable else "the model is NOT stable",
         )
-        return Verdict(0, True, False, stable, model.structure.nb + 1, msgs)
+        return Verdict(0, True, False, stable, model.structure.nb + 1, notes)
     n_null = int(np.asarray(info["n_null"])[output])
     n_input = int(np.asarray(info["n_input_relations"])[output])
     determined = bool(np.asarray(info["determined"])[output])
