@@ -14,13 +14,16 @@ from clpc.plants import (
     multisine,
     prbs,
     ramp_with_saturation,
+    servo_filters,
+    servo_layout,
+    servo_loop,
+    servo_run,
     simulate_motor_open_loop,
     simulate_servo,
     steps,
     time_grid,
     trapezoid_moves,
 )
-from clpc.plants import servo as servo_mod
 
 # a parameter set without any noise, quantisation or friction: the loop is linear
 LINEAR = dict(
@@ -79,13 +82,15 @@ def test_loop_functions_agree_directly():
     cmd = np.r_[np.zeros(3), np.ones(17)]
     noise = 1e-4 * rng.standard_normal(cmd.size * steps_per_sample)
     dist = 0.05 * rng.standard_normal(cmd.size * steps_per_sample)
-    p = servo_mod._pack(params, rate, open_loop=False)
-    filt = servo_mod._filter_coefficients(params, rate)
+    p = servo_layout._pack(params, rate, open_loop=False)
+    filt = servo_filters._filter_coefficients(params, rate)
+    config = servo_layout.LoopConfig(steps_per_sample, 2, p, filt)
+    inputs = servo_layout.LoopInputs(cmd, noise, dist)
     outs = []
-    for loop in (servo_mod._servo_loop_py, servo_mod._servo_loop_jit):
-        state = np.zeros(servo_mod._N_S)
-        out = np.empty((cmd.size, servo_mod._N_OUT))
-        loop(cmd, steps_per_sample, 2, p, filt, state, noise, dist, out)
+    for loop in (servo_loop._servo_loop_py, servo_loop._servo_loop_jit):
+        state = np.zeros(servo_layout._N_S)
+        out = np.empty((cmd.size, servo_layout._N_OUT))
+        loop(config, inputs, state, out)
         outs.append((out, state))
     np.testing.assert_allclose(outs[0][0], outs[1][0], rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(outs[0][1], outs[1][1], rtol=1e-12, atol=1e-12)
@@ -109,7 +114,7 @@ def test_chunking_does_not_change_the_result(monkeypatch):
     params = ServoParameters(**NOISY)
     cmd = _step(5, 40)
     whole = simulate_servo(cmd, params=params, seed=3)
-    monkeypatch.setattr(servo_mod, "_CHUNK", 7)
+    monkeypatch.setattr(servo_run, "_CHUNK", 7)
     pieces = simulate_servo(cmd, params=params, seed=3)
     for name, x in _fields(whole).items():
         np.testing.assert_array_equal(x, getattr(pieces, name), err_msg=name)
@@ -448,11 +453,11 @@ def test_generators_feed_the_servo():
 
 
 def test_pure_python_fallback_when_numba_is_missing(monkeypatch):
-    monkeypatch.setattr(servo_mod, "_JIT_CACHE", {"loop": None})
-    assert not servo_mod.numba_available()
+    monkeypatch.setattr(servo_loop, "_JIT_CACHE", {"loop": None})
+    assert not servo_loop.numba_available()
     rec = simulate_servo(_step(2, 3), seed=0)  # "auto" falls back to plain Python
     assert np.all(np.isfinite(rec.position))
     with pytest.raises(ValueError, match="needs numba"):
         simulate_servo(_step(2, 3), engine="numba")
     with pytest.raises(AttributeError, match="numba is not installed"):
-        servo_mod._servo_loop_jit  # noqa: B018
+        servo_loop._servo_loop_jit  # noqa: B018

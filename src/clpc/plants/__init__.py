@@ -2,20 +2,17 @@
 
 * :mod:`clpc.plants.servo` - the position-controlled brushless servo of the paper's
   Fig. 4 (cascaded P position / PI velocity loops, torque low-pass and notch filters,
-  current limit, two-mass mechanics with friction, quantised noisy resolver);
-* :mod:`clpc.plants.commands` - position command generators (the paper's Fig. 5 ramp
-  with saturation, steps, trapezoidal moves, chirp, PRBS, multisine).
+  current limit, two-mass mechanics with friction, quantised noisy resolver); its
+  parameters are :mod:`clpc.plants.servo_parameters`, its logs
+  :mod:`clpc.plants.servo_records`, its compiled inner loop :mod:`clpc.plants.servo_loop`;
+* :mod:`clpc.plants.commands` - position commands (the paper's Fig. 5 ramp with
+  saturation, steps, trapezoidal moves) on the sample grid of :mod:`clpc.plants.grid`;
+* :mod:`clpc.plants.excitation` - excitation signals (chirp, PRBS, multisine).
 """
 
-from clpc.plants.commands import (
-    chirp,
-    multisine,
-    prbs,
-    ramp_with_saturation,
-    steps,
-    time_grid,
-    trapezoid_moves,
-)
+from clpc.plants.commands import ramp_with_saturation, steps, trapezoid_moves
+from clpc.plants.excitation import chirp, multisine, prbs
+from clpc.plants.grid import time_grid
 from clpc.plants.servo import (
     MotorRecord,
     ServoParameters,
