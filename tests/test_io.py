@@ -20,7 +20,7 @@ from clpc.io import (
     read_table,
     write_table,
 )
-from clpc.io import tables as cio
+from clpc.io import parquet as io_parquet
 
 VALUES = np.array([[0.0, 1.5, -2.0], [0.1, 2.5, 3.25], [0.2, -1e-3, 4e5]])
 
@@ -259,7 +259,7 @@ def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
         read_table(path, columns=["gap"])
     data = load_iodata(path, "u", "flag", time_column="t")
     assert data.dt == 0.01
-    monkeypatch.setattr(cio, "_import_pyarrow", lambda: None)  # pandas path
+    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)  # pandas path
     np.testing.assert_array_equal(read_table(path, columns=["u", "flag"]).data, got.data[:, 1:])
     with pytest.raises(DataError, match=r"row 2, column 'gap'"):
         read_table(path, columns=["gap"])
@@ -268,8 +268,8 @@ def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
 def test_parquet_without_pyarrow_or_pandas(tmp_path, monkeypatch):
     path = tmp_path / "x.parquet"
     path.write_bytes(b"PAR1")
-    monkeypatch.setattr(cio, "_import_pyarrow", lambda: None)
-    monkeypatch.setattr(cio, "_import_pandas", lambda: None)
+    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)
+    monkeypatch.setattr(io_parquet, "_import_pandas", lambda: None)
     with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):
         read_table(path)
     with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):

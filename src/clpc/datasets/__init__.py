@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from clpc.data import IOData
+from clpc.io import Table, read_table
 
 __all__ = ["DATASETS", "Dataset", "load", "names"]
 
@@ -90,12 +91,34 @@ DATASETS: dict[str, Dataset] = {
 
 
 def names() -> list[str]:
-    """Names of the shipped records."""
+    """Names of the shipped records.
+
+    Returns
+    -------
+    list of str
+        The keys of :data:`DATASETS`, e.g. ``"dryer"``.
+    """
     return list(DATASETS)
 
 
 def path(name: str) -> Path:
-    """Path of the CSV file of record ``name``."""
+    """Path of the CSV file of record ``name``.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`names`.
+
+    Returns
+    -------
+    Path
+        The CSV file (a header line of column names, then one sample per line).
+
+    Raises
+    ------
+    KeyError
+        An unknown record name (the message lists the known ones).
+    """
     return _HERE / _spec(name).file
 
 
@@ -105,11 +128,9 @@ def _spec(name: str) -> Dataset:
     return DATASETS[name]
 
 
-def _columns(file: str) -> tuple[list[str], np.ndarray]:
-    p = _HERE / file
-    with p.open() as fh:
-        header = fh.readline().strip().split(",")
-    return header, np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+def _block(table: Table, names: tuple[str, ...]) -> np.ndarray:
+    """Columns ``names`` of ``table``, shape (n_samples, len(names))."""
+    return table.data[:, [table.index(c) for c in names]]
 
 
 def load(name: str) -> IOData | tuple[IOData, IOData]:
@@ -122,16 +143,22 @@ def load(name: str) -> IOData | tuple[IOData, IOData]:
 
     Returns
     -------
-    IOData, or (estimation, validation) for records that come split (cascaded_tanks).
-    Records with no sample time given get ``dt = 1`` (frequencies per sample).
+    IOData or tuple of IOData
+        ``u`` of shape (n_samples, n_inputs), ``y`` of shape (n_samples, n_outputs),
+        ``dt`` in seconds; ``(estimation, validation)`` for records that come split
+        (cascaded_tanks). Records with no sample time given get ``dt = 1`` (frequencies
+        per sample).
+
+    Raises
+    ------
+    KeyError
+        An unknown record name (the message lists the known ones).
     """
     spec = _spec(name)
-    header, values = _columns(spec.file)
+    table = read_table(_HERE / spec.file)
 
     def pick(ins: tuple[str, ...], outs: tuple[str, ...]) -> IOData:
-        u = values[:, [header.index(c) for c in ins]]
-        y = values[:, [header.index(c) for c in outs]]
-        return IOData(u, y, spec.dt or 1.0, ins, outs)
+        return IOData(_block(table, ins), _block(table, outs), spec.dt or 1.0, ins, outs)
 
     est = pick(spec.inputs, spec.outputs)
     if spec.validation is None:

@@ -1,14 +1,26 @@
-"""Files: tables (CSV, Parquet, npy/npz) in and out, model files."""
+"""Files: tables (CSV, Parquet, npy/npz) in and out, model files.
 
+Where each job lives (one module each):
+
+- ``table``: the :class:`Table` container, column selection, the shared types;
+- ``errors``: :class:`DataFileNotFoundError` and the one-line bad-cell messages;
+- ``formats``: which format a file is (by its extension), and that it exists;
+- ``text_format``: delimiter and header detection of text files;
+- ``text_reader``: parsing text files batch by batch; ``text_writer``: writing them;
+- ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
+- ``loading``: :func:`read_table`, :func:`iter_table_chunks` (dispatch by extension);
+- ``records``: :func:`load_iodata`; ``writing``: :func:`write_table`;
+- ``model_schema``: the model file schema and :func:`~clpc.io.model_files.model_to_dict`;
+- ``model_validation``: checking a decoded model file (``model_from_dict``);
+- ``model_files``: :func:`save_model`, :func:`load_model`.
+"""
+
+from clpc.io.errors import DataFileNotFoundError
+from clpc.io.loading import iter_table_chunks, read_table
 from clpc.io.model_files import ModelFileError, load_model, save_model
-from clpc.io.tables import (
-    DataFileNotFoundError,
-    Table,
-    iter_table_chunks,
-    load_iodata,
-    read_table,
-    write_table,
-)
+from clpc.io.records import load_iodata
+from clpc.io.table import Table
+from clpc.io.writing import write_table
 
 __all__ = [
     "DataFileNotFoundError",

@@ -1,0 +1,207 @@
+"""Parsing the numbers of a text data file (CSV/TSV/whitespace), batch by batch.
+
+Numbers are parsed in C by :func:`numpy.loadtxt` in batches of lines; only a batch that
+fails is re-read in Python to report the exact line, column and text.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import warnings
+from collections.abc import Iterator
+from itertools import islice, repeat
+from pathlib import Path
+
+import numpy as np
+
+from clpc.data import DataError
+from clpc.io.errors import cell_error, first_bad, show
+from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
+from clpc.io.text_format import (
+    TextFormat,
+    decode_error,
+    is_content,
+    open_text,
+    sniff,
+    split_fields,
+)
+
+__all__ = ["TextReader", "text_source"]
+
+
+class TextReader:
+    """Parses batches of lines of one text file into float64 arrays.
+
+    Parameters
+    ----------
+    path : Path
+        The text file.
+    fmt : TextFormat
+        Its layout (from :func:`~clpc.io.text_format.sniff`).
+    use : list of int
+        The sorted unique 0-based columns to read.
+    allow_missing : bool
+        Keep empty cells and NaN/inf as NaN instead of raising.
+    """
+
+    def __init__(self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool):
+        self.path = path
+        self.source = show(path)
+        self.fmt = fmt
+        self.use = use
+        self.full = use == list(range(fmt.n_cols))
+        self.allow_missing = allow_missing
+
+    def batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time."""
+        with open_text(self.path) as f:
+            try:
+                for _ in range(self.fmt.data_line - 1):
+                    next(f, None)
+                line_no = self.fmt.data_line
+                while True:
+                    lines = list(islice(f, chunk_rows))
+                    if not lines:
+                        return
+                    data, rows = self.parse(lines, line_no)
+                    line_no += len(lines)
+                    if data.shape[0]:
+                        yield data, rows
+            except UnicodeDecodeError as exc:
+                raise decode_error(self.path, exc) from None
+
+    def parse(self, lines: list[str], first_no: int) -> tuple[np.ndarray, np.ndarray]:
+        """Values (n, len(use)) and 1-based line numbers (n,) of a batch of lines."""
+        arr = self._fast(lines)
+        rows: np.ndarray | None = None
+        if arr is not None:
+            if arr.shape[0] == len(lines):
+                rows = np.arange(first_no, first_no + len(lines), dtype=np.int64)
+            else:
+                idx = [i for i, line in enumerate(lines) if is_content(line)]
+                if len(idx) == arr.shape[0]:
+                    rows = first_no + np.asarray(idx, dtype=np.int64)
+        if arr is None or rows is None:
+            return self._slow(lines, first_no)
+        if not self.allow_missing:
+            bad = first_bad(arr)
+            if bad is not None:
+                row, col = bad
+                no = int(rows[row])
+                fields = split_fields(lines[no - first_no], self.fmt.delimiter, strip_comment=True)
+                c = self.use[col]
+                text = fields[c] if c < len(fields) else str(arr[row, col])
+                raise cell_error(f"line {no}", self.fmt.names[c], text, self.source)
+        return arr, rows
+
+    def _fast(self, lines: list[str]) -> np.ndarray | None:
+        """numpy.loadtxt on the batch; None when anything looks unusual."""
+        fmt = self.fmt
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "input contained no data"
+                if not self.full and not self._field_counts_ok(lines):
+                    return None
+                arr = np.loadtxt(
+                    lines,
+                    dtype=np.float64,
+                    delimiter=fmt.delimiter,
+                    comments="#",
+                    quotechar='"',
+                    ndmin=2,
+                    usecols=None if self.full else self.use,
+                )
+                n_cols = fmt.n_cols if self.full else len(self.use)
+                if arr.shape[0] == 0:
+                    return np.empty((0, n_cols))
+                if arr.shape[1] != n_cols:
+                    return None
+                return arr
+        except ValueError:
+            return None
+
+    def _field_counts_ok(self, lines: list[str]) -> bool:
+        """Every content line has ``n_cols`` fields (a cheap check: no quotes or comments)."""
+        n = len(lines)
+        if self.fmt.delimiter is None:
+            counts = np.fromiter(map(len, map(str.split, lines)), dtype=np.int64, count=n)
+            expected = self.fmt.n_cols
+        else:
+            if any(map(operator.contains, lines, repeat('"'))):
+                return False
+            counts = np.fromiter(
+                map(str.count, lines, repeat(self.fmt.delimiter)), dtype=np.int64, count=n
+            )
+            expected = self.fmt.n_cols - 1
+        bad = np.flatnonzero(counts != expected)
+        return all(not is_content(lines[i]) for i in bad)
+
+    def _slow(self, lines: list[str], first_no: int) -> tuple[np.ndarray, np.ndarray]:
+        """Python parsing of a batch: exact diagnostics (line, column, text)."""
+        fmt = self.fmt
+        values: list[list[float]] = []
+        rows: list[int] = []
+        for i, line in enumerate(lines):
+            if not is_content(line):
+                continue
+            no = first_no + i
+            fields = split_fields(line, fmt.delimiter, strip_comment=True)
+            if len(fields) != fmt.n_cols:
+                raise self._ragged(no, len(fields))
+            values.append([self._cell(fields[c], no, c) for c in self.use])
+            rows.append(no)
+        arr = np.array(values, dtype=np.float64).reshape(len(values), len(self.use))
+        return arr, np.asarray(rows, dtype=np.int64)
+
+    def _cell(self, text: str, no: int, c: int) -> float:
+        """The value of field ``text`` in column ``c`` of line ``no`` (empty: NaN)."""
+        try:
+            value = float(text) if text else math.nan
+        except ValueError:
+            raise cell_error(f"line {no}", self.fmt.names[c], text, self.source) from None
+        if not self.allow_missing and not math.isfinite(value):
+            raise cell_error(f"line {no}", self.fmt.names[c], text, self.source)
+        return value
+
+    def _ragged(self, no: int, got: int) -> DataError:
+        fmt = self.fmt
+        if fmt.header_line is not None:
+            ref = f"the header (line {fmt.header_line})"
+        else:
+            ref = f"the first data row (line {fmt.data_line})"
+        return DataError(
+            f"{self.source} line {no} has {got} field(s) but {ref} has {fmt.n_cols} "
+            f"(delimiter {fmt.describe_delimiter()}); fix or remove that row, or pass "
+            "delimiter= if the separator was guessed wrongly."
+        )
+
+
+def text_source(
+    path: Path,
+    columns: Columns,
+    delimiter: str | None,
+    header: bool | None,
+    allow_missing: bool,
+) -> tuple[list[str], Chunks]:
+    """Names of the selected columns of a text file and a chunk generator over them.
+
+    Parameters
+    ----------
+    path : Path
+        An existing text data file.
+    columns, delimiter, header, allow_missing
+        As for :func:`clpc.io.read_table`.
+
+    Returns
+    -------
+    names : list of str
+        The selected column names, in the order asked for.
+    chunks : Chunks
+        ``chunks(chunk_rows)`` yields values and the 1-based line number of each row.
+    """
+    fmt = sniff(path, delimiter, header)
+    sel = resolve_columns(fmt.names, columns, show(path))
+    use = sorted(set(sel))
+    reader = TextReader(path, fmt, use, allow_missing)
+    return [fmt.names[i] for i in sel], reorder_columns(reader.batches, use, sel)
