@@ -110,7 +110,6 @@ def _parents(name: str) -> set[str]:
     return {".".join(parts[:i]) for i in range(2, len(parts))}
 
 
-@pytest.mark.xfail(strict=True, reason="experiment.run <-> report/figures: to be split")
 def test_no_import_cycle():
     # edges: module -> what it imports (package facades excluded: they only re-export)
     edges = {m: {d for d in deps if d != "clpc"} for m, deps in GRAPH.items() if m != "clpc"}

@@ -16,6 +16,7 @@ import pytest
 from scipy import signal
 
 import clpc
+from clpc.experiment import analysis, decimate, settings
 from clpc.experiment import run as ex
 from clpc.experiment.figures import FILES, RICH_FILE
 from clpc.experiment.report import render_report
@@ -95,7 +96,7 @@ def test_d_is_quasi_constant_after_the_fill_for_the_rich_command(
     for ident in ("control_system", "actuator"):
         d = run[0]["commands"]["rich"][ident]["D"]
         assert d["after_fill"]["cv"] < d["fill"]["cv"]
-        assert d["after_fill"]["cv"] < ex.D_QUASI_CONSTANT
+        assert d["after_fill"]["cv"] < settings.D_QUASI_CONSTANT
         assert d["quasi_constant_after_fill"] and d["more_constant_after_fill"]
 
 
@@ -174,7 +175,7 @@ def test_decimate_matches_the_appraiser(rng: np.random.Generator) -> None:
     u = np.cumsum(rng.standard_normal(3000)) * 0.01
     y = signal.lfilter([0.0, 0.2], [1.0, -0.8], u) + 1e-3 * rng.standard_normal(3000)
     fast = clpc.CLPC(3, 60, 12, 0.01).run(u, y, dt=0.001)
-    slow = clpc.CLPC(3, 60, 12, 0.01).run(ex.decimate(u, 10), ex.decimate(y, 10), dt=0.01)
+    slow = clpc.CLPC(3, 60, 12, 0.01).run(decimate(u, 10), decimate(y, 10), dt=0.01)
     np.testing.assert_array_equal(fast.index, slow.index)
     np.testing.assert_allclose(fast.theta, slow.theta, atol=1e-12)
 
@@ -186,14 +187,14 @@ def test_stable_inverse_recovers_a_non_minimum_phase_input(make_model, rng) -> N
     y = signal.lfilter(num, den, u)
     with pytest.raises(clpc.ModelError, match="unstable"):
         model.infer_input(y)
-    u_hat = ex.stable_inverse(model, y)
+    u_hat = analysis.stable_inverse(model, y)
     np.testing.assert_allclose(u_hat[:-40], u[:-40], atol=1e-8)
 
 
 def test_stable_inverse_equals_the_causal_inverse_when_minimum_phase(make_model, rng) -> None:
     model = make_model(np.array([1.0, -1.2, 0.5]), np.array([1.0, 0.4, 0.1]), intercept=0.3)
     y = np.cumsum(rng.standard_normal(300))
-    np.testing.assert_allclose(ex.stable_inverse(model, y), model.infer_input(y), atol=1e-10)
+    np.testing.assert_allclose(analysis.stable_inverse(model, y), model.infer_input(y), atol=1e-10)
 
 
 def test_free_run_reproduces_noise_free_data(make_model, rich_input) -> None:
@@ -201,7 +202,7 @@ def test_free_run_reproduces_noise_free_data(make_model, rich_input) -> None:
     model = make_model(den, num)
     u = rich_input(400)
     y = signal.lfilter(num, den, u)
-    np.testing.assert_allclose(ex.free_run(model, u, y), y, atol=1e-9)
+    np.testing.assert_allclose(analysis.free_run(model, u, y), y, atol=1e-9)
 
 
 def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> None:
@@ -209,7 +210,7 @@ def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> Non
     y = siso2.output(u)
     trace = clpc.CLPC(3, 100, 12, 1.0).run(u, y)
     for k in (1, 10):
-        res = ex.online_prediction(trace, u, y, k)
+        res = analysis.online_prediction(trace, u, y, k)
         assert res["fit"] > 100.0 - 1e-6
         assert 0.95 < res["coverage"] <= 1.0
 
@@ -217,12 +218,12 @@ def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> Non
 def test_error_profile_on_a_decaying_error() -> None:
     t = np.arange(500) * 0.01
     err = np.exp(-t) * np.where(t > 0.2, 1.0, 0.5)
-    prof = ex.error_profile(err, 0.01, corner=0.2)
+    prof = analysis.error_profile(err, 0.01, corner=0.2)
     assert prof["rms_last_second"] < prof["rms_first_second"]
     assert prof["peak_time"] == pytest.approx(0.21)
     assert len(prof["rms_per_second"]) == 5
     assert prof["corner_peak"] == pytest.approx(prof["peak"])
-    assert ex.error_profile(np.array([0.0, np.inf]), 0.01) == {"diverged": True}
+    assert analysis.error_profile(np.array([0.0, np.inf]), 0.01) == {"diverged": True}
 
 
 def test_duration_must_cover_the_ramp_and_the_window(tmp_path: Path) -> None:

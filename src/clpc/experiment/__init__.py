@@ -1,5 +1,10 @@
-"""The paper's section VI experiment on the simulated brushless servo, end to end."""
+"""The paper's section VI experiment on the simulated brushless servo, end to end.
 
-from clpc.experiment.run import decimate, error_profile, free_run, run_experiment, stable_inverse
+``decimate`` is the appraiser's own (:func:`clpc.appraiser.decimation.decimate`), re-exported.
+"""
+
+from clpc.appraiser.decimation import decimate
+from clpc.experiment.analysis import error_profile, free_run, stable_inverse
+from clpc.experiment.run import run_experiment
 
 __all__ = ["decimate", "error_profile", "free_run", "run_experiment", "stable_inverse"]

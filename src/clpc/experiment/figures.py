@@ -8,15 +8,17 @@ functions. Every figure carries the paper's number in its title and units on its
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+from clpc.experiment.results import CommandResult, Identification
+from clpc.experiment.settings import LOG_SAMPLE_TIME, SAMPLE_TIME
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
-
-    from clpc.experiment.run import CommandResult, Identification
 
 __all__ = ["write_figures"]
 
@@ -55,9 +57,14 @@ def _save(fig: Figure, path: Path, dpi: int) -> str:
 
 def _time_axis(ax: Axes, dt_cluster: float, t0: float) -> None:
     """Secondary x axis: the time [s] of the newest sample of cluster ``j``."""
-    sec = ax.secondary_xaxis(
-        "top", functions=(lambda j: t0 + (j - 1) * dt_cluster, lambda t: (t - t0) / dt_cluster + 1)
-    )
+
+    def to_time(j: ArrayLike) -> np.ndarray:
+        return np.asarray(t0 + (np.asarray(j) - 1) * dt_cluster)
+
+    def to_cluster(t: ArrayLike) -> np.ndarray:
+        return np.asarray((np.asarray(t) - t0) / dt_cluster + 1)
+
+    sec = ax.secondary_xaxis("top", functions=(to_time, to_cluster))
     sec.set_xlabel("time of the update [s]")
 
 
@@ -90,8 +97,6 @@ def _per_cluster(ax: Axes, ident: Identification, values: np.ndarray, label: str
 
 def fig_command(path: Path, result: CommandResult, dpi: int) -> str:
     """Fig. 5: the position command (ramp with saturation) [rad]."""
-    from clpc.experiment.run import LOG_SAMPLE_TIME
-
     fig = _figure()
     ax = fig.add_subplot()
     t = np.arange(result.command_log.size) * LOG_SAMPLE_TIME
@@ -138,8 +143,6 @@ def fig_parameter(path: Path, result: CommandResult, index: int, number: int, dp
 
 
 def _time(n: int) -> np.ndarray:
-    from clpc.experiment.run import SAMPLE_TIME
-
     return np.arange(n) * SAMPLE_TIME
 
 
@@ -244,7 +247,7 @@ def fig_rich(path: Path, ramp: CommandResult, rich: CommandResult, dpi: int) -> 
 
 def write_figures(
     out_dir: Path, ramp: CommandResult, rich: CommandResult, *, quick: bool = False
-) -> dict[str, Any]:
+) -> dict[int | str, str]:
     """Write Figs. 5-17 (from the ramp run) and the rich-command figure.
 
     Parameters
@@ -252,7 +255,7 @@ def write_figures(
     out_dir : Path
         Existing output folder.
     ramp, rich : CommandResult
-        Results of :func:`clpc.experiment.analyse_command`.
+        Results of :func:`clpc.experiment.evaluation.analyse_command`.
     quick : bool
         Lower resolution (faster).
 
@@ -262,7 +265,7 @@ def write_figures(
         Figure number (or ``"rich"``) -> file name.
     """
     dpi = 60 if quick else 110
-    out: dict[str, Any] = {
+    out: dict[int | str, str] = {
         5: fig_command(out_dir / FILES[5], ramp, dpi),
         6: fig_d(out_dir / FILES[6], ramp, dpi),
     }

@@ -1,20 +1,23 @@
-"""Reports: HTML and Markdown summaries of fits and traces."""
+"""Reports: HTML and Markdown summaries of fits and traces.
 
-from clpc.report.html import (
-    Section,
-    format_fit,
-    format_model_summary,
-    jsonable,
+``jsonable`` (:func:`clpc.core.jsonable.jsonable`) and ``trace_columns``
+(:func:`clpc.appraiser.tracefile.trace_columns`) are re-exported for the callers that took
+them from here.
+"""
+
+from clpc.appraiser.tracefile import trace_columns
+from clpc.core.jsonable import jsonable
+from clpc.report.html import Section, write_html_report
+from clpc.report.summaries import (
     model_response,
     model_summary,
     steady_state,
-    trace_columns,
     trace_summary,
     update_records,
     verdict_text,
-    write_html_report,
-    write_track_report,
 )
+from clpc.report.text import format_fit, format_model_summary
+from clpc.report.track import write_track_report
 
 __all__ = [
     "Section",

@@ -1,0 +1,121 @@
+"""Markdown building blocks of the experiment report: figures, claims, tables.
+
+Each function reads the JSON-safe summary of :func:`clpc.experiment.run_experiment` and
+returns Markdown text.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from clpc.experiment.claims import claim_row, fmt, fmt_poles
+
+__all__ = [
+    "baseline_rows",
+    "claim_block",
+    "img",
+    "model_row",
+    "setup_table",
+    "verdict_table",
+    "yes",
+]
+
+
+def img(summary: dict[str, Any], number: int | str, caption: str) -> str:
+    """A figure of the report with its caption and file name."""
+    name = summary["figures"][str(number)]
+    return f"![{caption}]({name})\n\n*{caption}* (`{name}`)\n"
+
+
+def claim_block(summary: dict[str, Any], key: str) -> str:
+    """The paper's words of claim ``key`` and its verdict and numbers per command."""
+    row = claim_row(summary, key)
+    lines = [f"> **Paper:** {row['paper']}.\n"]
+    for name in ("ramp", "rich"):
+        if name in row:
+            lines.append(f"- **{name}** - *{row[name]['verdict']}*: {row[name]['numbers']}.")
+    return "\n".join(lines) + "\n"
+
+
+def model_row(label: str, m: dict[str, Any]) -> str:
+    """One row of the steady-state models table."""
+    poles = fmt_poles(m["poles"])
+    zeros = ", ".join(
+        f"{re:.3g}{im:+.3g}j" if abs(im) > 1e-9 else f"{re:.3g}" for re, im in m["zeros"]
+    )
+    den = ", ".join(f"{v:.4f}" for v in m["den"])
+    num = ", ".join(f"{v:.4g}" for v in m["num"])
+    return (
+        f"| {label} | [{den}] | [{num}] | {poles} | {zeros} | {fmt(m['dc_gain'], '.4g')} "
+        f"| {'yes' if m['stable'] else 'no'} |"
+    )
+
+
+def baseline_rows(summary: dict[str, Any]) -> list[str]:
+    """The fit table: CLPC (steady state, on-line) against the global fits."""
+    rows = [
+        "| record | identification | metric | CLPC steady state | CLPC on-line (held) "
+        "| global LPC | least squares | global LPC, N = 1 |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, cmd in summary["commands"].items():
+        for ident, metrics in (
+            ("control system", ("simulation_fit", "k1_fit", "k10_fit")),
+            ("actuator", ("k1_fit", "k10_fit")),
+        ):
+            b = cmd["control_system" if ident == "control system" else "actuator"]["baselines"]
+            for metric in metrics:
+                cells = [
+                    fmt(b[k].get(metric), ".2f") if k in b else "-"
+                    for k in ("clpc", "clpc_online", "lpc", "arx", "lpc_order1")
+                ]
+                label = {
+                    "simulation_fit": "free-run fit %",
+                    "k1_fit": "1-step fit %",
+                    "k10_fit": "10-step fit %",
+                }[metric]
+                rows.append(f"| {name} | {ident} | {label} | " + " | ".join(cells) + " |")
+    return rows
+
+
+def setup_table(summary: dict[str, Any]) -> str:
+    """The set-up table: Table 1 of the paper beside the settings used here."""
+    s = summary["settings"]
+    ramp, rich = s["ramp"], s["rich"]
+    tol = "; ".join(f"({t[0]}, {t[1]}, {t[2]})" for t in s["tolerances"])
+    return f"""| setting | paper (Table 1) | here |
+|---|---|---|
+| sample time | 10 ms | {1e3 * s["sample_time"]:.0f} ms (appraiser); servo logged at \
+{1e3 * s["log_sample_time"]:.0f} ms, anti-alias filtered and decimated by the appraiser |
+| parameter_size | 3 (N = 2) | {s["parameters_size"]} |
+| window_size | 201 samples (2 s) | {s["window_size"]} samples ({s["window_time"]:.1f} s) |
+| data_cluster_dimension | 12 samples | {s["cluster_size"]} samples |
+| LPC solution | eigenvector of the smallest eigenvalue | `method="{s["method"]}"`, every \
+computable estimate accepted (`gate=False`) |
+| command | ramp with saturation (Fig. 5) | ramp 0 -> {ramp["level"]} rad from \
+{ramp["start"]} s to {ramp["start"] + ramp["ramp_time"]:.1f} s, then held; \
+{ramp["duration"]:.1f} s record |
+| richer command | - | ramp-and-hold moves {rich["positions"][0]} <-> {rich["positions"][1]} rad \
+({rich["max_velocity"]} rad/s, {rich["max_acceleration"]} rad/s^2, {rich["dwell"]} s dwell: a 2 s \
+period, the window length) + PRBS dither {rich["dither"]["amplitude"]} rad, \
+{rich["dither"]["min_hold"]} s minimum hold; {rich["duration"]:.0f} s record |
+| convergence tolerances | "quasi constant" | (theta_tol, D_tol, consecutive) tried in order: \
+{tol}; none met -> last accepted update |
+
+Seed {s["seed"]}; quick = {s["quick"]}; run time {summary["runtime_s"]:.1f} s.
+"""
+
+
+def verdict_table(summary: dict[str, Any]) -> str:
+    """One row per claim: its figures and the verdict for each command."""
+    rows = ["| paper's claim | figures | ramp (Fig. 5) | rich command |", "|---|---|---|---|"]
+    for c in summary["claims"]:
+        figs = ", ".join(str(f) for f in c["figures"]) or "-"
+        cells = [c[n]["verdict"] if n in c else "-" for n in ("ramp", "rich")]
+        rows.append(f"| {c['paper']} | {figs} | {cells[0]} | {cells[1]} |")
+    return "\n".join(rows) + "\n"
+
+
+def yes(flag: bool, yes: str, no: str) -> str:
+    """``yes`` if ``flag`` else ``no``."""
+    return yes if flag else no

@@ -1,0 +1,253 @@
+"""Summaries of identified models and traces, as JSON-safe dicts.
+
+* :func:`model_summary` - transfer functions, poles, stability, ``D``, fit % of the free-run
+  simulation and of k-step predictions, and the identifiability verdict in plain words.
+* :func:`model_response` - simulated or k-step-predicted output and its fit %.
+* :func:`update_records` - a CLPC trace as JSON-safe records (one per cluster update).
+* :func:`steady_state` / :func:`trace_summary` - the model a trace settles on, and the
+  trace's counts, convergence and findings.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from clpc.analysis.metrics import fit_percent
+from clpc.appraiser.trace import SCALAR_KEYS, Trace
+from clpc.core.jsonable import jsonable
+from clpc.data import IOData
+from clpc.model import LinearModel
+from clpc.model.verdict import describe_trace, fit_verdict
+
+__all__ = [
+    "model_response",
+    "model_summary",
+    "steady_state",
+    "trace_summary",
+    "update_records",
+    "verdict_text",
+]
+
+
+def verdict_text(model: LinearModel, output: int = 0) -> str | None:
+    """The identifiability verdict of one output equation in plain words.
+
+    Uses :func:`clpc.verdict.fit_verdict` on the statistics in ``model.info``
+    (``determined``, ``n_null``, ``n_input_relations``...); ``None`` for models without
+    them (e.g. a CLPC steady-state model or a hand-built one).
+    """
+    if not all(k in model.info for k in ("n_null", "n_input_relations", "determined")):
+        return None
+    return str(fit_verdict(model, output))
+
+
+def model_response(
+    model: LinearModel, u: Any, y: Any, k: int | None = None
+) -> tuple[np.ndarray, int, np.ndarray]:
+    """Simulated (``k=None``) or ``k``-step-predicted output of a model on measured data.
+
+    Parameters
+    ----------
+    model : LinearModel
+    u : array_like, shape (T, n_inputs)
+        Measured inputs.
+    y : array_like, shape (T, n_outputs)
+        Measured outputs.
+    k : int, optional
+        Prediction horizon in samples; ``None`` for the free-run simulation.
+
+    Returns
+    -------
+    y_hat : ndarray, shape (T, n_outputs)
+        Model output. The first ``max_lag`` samples have no complete past and are copied
+        from ``y``; the free-run simulation starts from those measured samples (initial
+        conditions) and then uses the input alone.
+    start : int
+        First compared sample (``max_lag``).
+    fit : ndarray, shape (n_outputs,)
+        Fit % over samples ``start:`` (NaN when the simulation diverges).
+    """
+    u2 = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
+    y2 = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
+    start = model.structure.max_lag
+    if y2.shape[0] <= start + 1:
+        raise ValueError(
+            f"comparing needs more than {start + 1} samples (the model's max lag is {start}); "
+            f"got {y2.shape[0]}."
+        )
+    if k is None:
+        y_hat = y2.copy()
+        with np.errstate(over="ignore", invalid="ignore"):
+            y_hat[start:] = model.simulate(u2[start:], y_init=y2[:start], u_init=u2[:start])
+    else:
+        y_hat = np.asarray(model.predict(u2, y2, k=k)).reshape(y2.shape)
+        start += k - 1  # only true k-step predictions are scored (as clpc.kstep_fit)
+    fit = np.full(y2.shape[1], np.nan)
+    for j in range(y2.shape[1]):  # per output: one diverging output leaves the others' fit
+        if np.all(np.isfinite(y_hat[start:, j])):
+            fit[j] = fit_percent(y2[start:, j], y_hat[start:, j])
+    return y_hat, start, fit
+
+
+def model_summary(
+    model: LinearModel, data: IOData | None = None, horizons: Sequence[int] = (1, 10)
+) -> dict[str, Any]:
+    """Everything worth printing about an identified model, JSON-safe.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model (monic engineering convention is reported: ``den = A(z)/a0`` with
+        ``den[0] = 1``, ``num = -B(z)/a0``, ascending powers of ``z^-1``).
+    data : IOData, optional
+        Record to evaluate on: fit % of the free-run simulation and of the ``k``-step
+        predictions for each ``k`` in ``horizons`` (see :func:`model_response`).
+    horizons : sequence of int
+        Prediction horizons.
+
+    Returns
+    -------
+    dict
+        Keys ``inputs``, ``outputs``, ``dt``, ``structure``, ``mode``, ``method``,
+        ``stable``, ``equations`` (one dict per output: ``den``, ``num`` per input,
+        ``intercept``, ``poles`` as ``[re, im]`` pairs, ``stable``, ``D``, ``lambda_min``,
+        ``eig_ratio``, ``noise_variance``, ``determined``, ``n_input_relations``,
+        ``verdict``) and, with data, ``n_samples`` and ``fit`` (``{"simulation": [...],
+        "prediction_1": [...], ...}``, one fit % per output, ``None`` if it diverges).
+    """
+    s = model.structure
+    info = model.info
+    dens, nums, icpt = model.denominators, model.numerators, model.intercept
+
+    def stat(key: str, j: int) -> Any:
+        return jsonable(np.atleast_1d(info[key])[j]) if key in info else None
+
+    equations = []
+    for j in range(model.n_outputs):
+        poles = model.poles(j)
+        equations.append(
+            {
+                "output": model.output_names[j],
+                "den": jsonable(dens[j]),
+                "num": {model.input_names[i]: jsonable(nums[j, i]) for i in range(model.n_inputs)},
+                "intercept": jsonable(icpt[j]),
+                "poles": [[jsonable(p.real), jsonable(p.imag)] for p in poles],
+                "stable": bool(np.all(np.abs(poles) < 1.0)),
+                "D": stat("D", j),
+                "lambda_min": stat("lambda_min", j),
+                "eig_ratio": stat("eig_ratio", j),
+                "noise_variance": stat("noise_variance", j),
+                "determined": stat("determined", j),
+                "n_input_relations": stat("n_input_relations", j),
+                "verdict": verdict_text(model, j),
+            }
+        )
+    out: dict[str, Any] = {
+        "inputs": list(model.input_names),
+        "outputs": list(model.output_names),
+        "dt": model.dt,
+        "structure": {"na": s.na, "nb": s.nb, "nk": s.nk},
+        "mode": model.mode,
+        "method": info.get("method"),
+        "stable": model.is_stable,
+        "equations": equations,
+    }
+    if data is not None:
+        fits: dict[str, Any] = {}
+        for k in (None, *horizons):
+            _, _, fit = model_response(model, data.u, data.y, k)
+            fits["simulation" if k is None else f"prediction_{k}"] = jsonable(fit)
+        out["n_samples"] = data.n_samples
+        out["fit"] = fits
+    return out
+
+
+def update_records(trace: Trace) -> list[dict[str, Any]]:
+    """One JSON-safe dict per cluster update of a trace.
+
+    Keys: ``index``, ``time``, ``rows``, ``not_enough_data``, ``theta`` (held parameter
+    vector, paper convention), ``den``, ``num`` (monic convention of the held ``theta``),
+    ``D``, ``lambda_min``, ``lambda_max``, ``eig_ratio``, ``separation``,
+    ``noise_variance``, ``J``, ``c``, ``n_null``, ``n_input_relations``, ``degenerate``,
+    ``determined``, ``accepted``, ``has_model``, ``stable``. For single-output traces the
+    per-equation values are scalars (``theta`` a list); otherwise one entry per output.
+    """
+    a = trace.arrays
+    single = trace.n_equations == 1
+    records = []
+    for i in range(len(trace)):
+        rec: dict[str, Any] = {
+            "index": int(trace.index[i]),
+            "time": float(trace.time[i]),
+            "rows": int(trace.rows[i]),
+            "not_enough_data": bool(trace.not_enough_data[i]),
+        }
+        for key in ("theta", "den", "num", *SCALAR_KEYS):
+            val = a[key][i]
+            if key == "num" and single and trace.n_inputs == 1:
+                val = val[:, 0]
+            rec[key] = jsonable(val[0] if single else val)
+        records.append(rec)
+    return records
+
+
+def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
+    """The model a trace settles on, and where it comes from.
+
+    Returns
+    -------
+    model : LinearModel or None
+        :meth:`Trace.steady_state_model` when the trace converged, else the last accepted
+        update, else ``None`` (no update was accepted).
+    source : str
+        ``"steady state"``, ``"last accepted update (not converged)"`` or ``"none"``.
+    """
+    conv = trace.convergence()
+    if conv.converged:
+        return trace.steady_state_model(conv), "steady state"
+    try:
+        model = trace.steady_state_model(conv, allow_unconverged=True)
+    except ValueError:
+        return None, "none"
+    return model, "last accepted update (not converged)"
+
+
+def trace_summary(trace: Trace) -> dict[str, Any]:
+    """Counts, convergence and plain-language findings of a CLPC trace, JSON-safe.
+
+    Returns
+    -------
+    dict
+        ``updates``, ``accepted``, ``determined``, ``not_enough_data`` (update counts; an
+        update counts when it holds for every output), ``D_last`` (per output),
+        ``convergence`` (the fields of :class:`clpc.Convergence`), ``findings``
+        (:func:`clpc.describe_trace`) and ``model`` (:func:`model_summary` of
+        :func:`steady_state`, or ``None``) with ``model_source``.
+    """
+    a = trace.arrays
+    conv = trace.convergence()
+    model, source = steady_state(trace)
+    n = len(trace)
+    return {
+        "updates": n,
+        "accepted": int(a["accepted"].all(axis=1).sum()),
+        "determined": int(a["determined"].all(axis=1).sum()),
+        "not_enough_data": int(np.sum(trace.not_enough_data)),
+        "D_last": jsonable(a["D"][-1]) if n else None,
+        "convergence": jsonable(
+            {
+                "converged": conv.converged,
+                "update": conv.update,
+                "index": conv.index,
+                "time": conv.time,
+                "theta_variation": conv.theta_variation,
+                "D_variation": conv.D_variation,
+            }
+        ),
+        "findings": describe_trace(trace) if n else [],
+        "model_source": source,
+        "model": None if model is None else model_summary(model),
+    }

@@ -1,0 +1,77 @@
+"""Model summaries and fit values as text for people (what the command line prints)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+__all__ = ["format_fit", "format_model_summary"]
+
+
+def _poly(coefs: Sequence[float], var: str = "z^-1") -> str:
+    terms = []
+    for i, c in enumerate(coefs):
+        if c == 0 and len(coefs) > 1:
+            continue
+        power = "" if i == 0 else (f" {var}" if i == 1 else f" {var[:-1]}{i}")
+        terms.append((c, f"{abs(c):.6g}{power}"))
+    if not terms:
+        return "0"
+    text = ("-" if terms[0][0] < 0 else "") + terms[0][1]
+    for c, t in terms[1:]:
+        text += (" - " if c < 0 else " + ") + t
+    return text
+
+
+def _fit_label(key: str) -> str:
+    return key if key == "simulation" else key.replace("prediction_", "") + "-step prediction"
+
+
+def format_fit(v: float | None) -> str:
+    """A fit % for people: ``"87.29 %"``, ``"-1.2e+34 %"`` or ``"n/a (diverges)"``."""
+    if v is None or not math.isfinite(v):
+        return "n/a (diverges)"
+    return f"{v:.2f} %" if abs(v) < 1e5 else f"{v:.3g} %"
+
+
+def format_model_summary(summary: Mapping[str, Any]) -> str:
+    """Render :func:`model_summary` as readable text (one block per output)."""
+    st = summary["structure"]
+    lines = [
+        f"LPC model  na={st['na']} nb={st['nb']} nk={st['nk']}  method={summary['method']}  "
+        f"mode={summary['mode']}  dt={summary['dt']:g} s",
+        f"inputs: {', '.join(summary['inputs'])}   outputs: {', '.join(summary['outputs'])}"
+        + (f"   samples: {summary['n_samples']}" if "n_samples" in summary else ""),
+        "transfer functions G(z) = -B(z)/A(z), monic A, powers of z^-1:",
+    ]
+    for j, eq in enumerate(summary["equations"]):
+        out = eq["output"]
+        lines.append(f"  [{out}]  A(z) = {_poly(eq['den'])}")
+        for inp, num in eq["num"].items():
+            lines.append(f"  [{out}]  {inp} -> {out}:  numerator {_poly(num)}")
+        if eq["intercept"]:
+            lines.append(f"  [{out}]  offset (intercept) {eq['intercept']:.6g}")
+        poles = ", ".join(_fmt_complex(re, im) for re, im in eq["poles"])
+        lines.append(f"  [{out}]  poles: {poles}  -> {'stable' if eq['stable'] else 'UNSTABLE'}")
+        if eq["D"] is not None:
+            lines.append(
+                f"  [{out}]  D = lambda_max - lambda_min = {eq['D']:.6g}   lambda_min = "
+                f"{eq['lambda_min']:.6g}   lambda_min/lambda_max = {eq['eig_ratio']:.3g}"
+            )
+        if eq["verdict"] is not None:
+            lines.append(f"  [{out}]  identifiability: {eq['verdict']}")
+        if "fit" in summary:
+            fits = "   ".join(
+                f"{_fit_label(key)} {format_fit(vals[j])}" for key, vals in summary["fit"].items()
+            )
+            lines.append(f"  [{out}]  fit: {fits}")
+    lines.append(f"model is {'stable' if summary['stable'] else 'UNSTABLE'}")
+    return "\n".join(lines)
+
+
+def _fmt_complex(re: float, im: float) -> str:
+    mag = math.hypot(re, im)
+    if abs(im) < 1e-12:
+        return f"{re:.5g}"
+    return f"{re:.5g}{'+' if im >= 0 else '-'}{abs(im):.5g}j (|p|={mag:.4g})"
