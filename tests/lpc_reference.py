@@ -98,6 +98,7 @@ def solve_scatter(
     noise_cov: np.ndarray | None = None,
     rule: RobustRule | None = None,
     data: np.ndarray | None = None,
+    scaling: str = "none",
 ) -> SolveResult:
     """Solve a stack of LPC problems given their scatter matrices.
 
@@ -137,8 +138,16 @@ def solve_scatter(
     n_rows = np.asarray(n_rows)
     n_safe = np.maximum(n_rows, 1).astype(np.float64)
 
-    transform = _whitening(scatter, n_rows, blocks, method, noise_cov)  # (k,p,p) or None
+    transform = _whitening(scatter, n_rows, blocks, scaling, noise_cov)  # (k,p,p) or None
     vals, vecs = _decompose(scatter, transform, data)
+    # unit-free weights: each eigenvector as a relation theta = T v, in units of the
+    # channels' spreads s: w = s * theta
+    tmat = np.broadcast_to(np.eye(p), (k, p, p)) if transform is None else transform
+    s_col = channel_scales(scatter, n_rows, blocks)
+    w = s_col[:, :, None] * (tmat @ vecs)  # (k, p, p): column i is eigenvector i
+    w2 = np.sum(w**2, axis=1)
+    a0w = np.abs(w[:, 0, :]) / np.sqrt(np.where(w2 > 0, w2, 1.0))
+    outw = np.sum(w[:, :n_output_cols, :] ** 2, axis=1) / np.where(w2 > 0, w2, 1.0)
     if transform is None:
         raw_vals = vals
     elif data is not None:
@@ -164,17 +173,17 @@ def solve_scatter(
     if method == "paper":
         phi = vecs[:, :, 0]
         n_null = np.ones(k, dtype=np.int64)
-        n_input = np.sum(vecs[:, :n_output_cols, 0] ** 2, axis=1) < rule.min_output_weight
-        n_input = n_input.astype(np.int64)
+        n_input = (outw[:, 0] < rule.min_output_weight).astype(np.int64)
         nxt = vals[:, 1] if p > 1 else vals[:, 0]
         separation = _ratio(vals[:, 0], nxt)
     else:
         ratio = degeneracy_ratio(rule, n_rows, p)
-        phi, n_null, n_input, separation = _robust_vector(vals, vecs, n_output_cols, rule, ratio)
+        phi, n_null, n_input, separation = _robust_vector(vals, vecs, (a0w, outw), rule, ratio)
 
-    phi_norm = np.linalg.norm(phi, axis=1)
-    a0_weight = np.abs(phi[:, 0]) / np.where(phi_norm > 0, phi_norm, 1.0)
     theta = phi if transform is None else np.einsum("kij,kj->ki", transform, phi)
+    wt = s_col * theta
+    wt_norm = np.linalg.norm(wt, axis=1)
+    a0_weight = np.abs(wt[:, 0]) / np.where(wt_norm > 0, wt_norm, 1.0)
     theta = _normalise(theta)
     theta[degenerate] = 0.0
     c = np.einsum("kp,kp->k", mean, theta)
@@ -206,13 +215,13 @@ def _whitening(
     scatter: np.ndarray,
     n_rows: np.ndarray,
     blocks: list[slice],
-    method: str,
+    scaling: str,
     noise_cov: np.ndarray | None,
 ) -> np.ndarray | None:
     """Transform ``T`` with ``T^T W T = I``: the solved problem is ``T^T A T``."""
     k, p, _ = scatter.shape
     if noise_cov is None:
-        if method == "paper":
+        if scaling == "none":
             return None
         scales = channel_scales(scatter, n_rows, blocks)
         return np.einsum("kp,pq->kpq", 1.0 / scales, np.eye(p))
@@ -250,16 +259,20 @@ def degeneracy_ratio(rule: RobustRule, n_rows: np.ndarray, p: int) -> np.ndarray
 
 
 def _robust_vector(
-    vals: np.ndarray, vecs: np.ndarray, n_output_cols: int, rule: RobustRule, ratio: np.ndarray
+    vals: np.ndarray,
+    vecs: np.ndarray,
+    weights: tuple[np.ndarray, np.ndarray],
+    rule: RobustRule,
+    ratio: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Minimum-norm ``a0 = 1`` vector in the near-null subspace, vectorised over windows."""
     k, p = vals.shape
     idx = np.arange(p)
     a0 = vecs[:, 0, :]  # (k, p): y(n) component of each eigenvector
-    out_w = np.sum(vecs[:, :n_output_cols, :] ** 2, axis=1)  # (k, p)
-    cand = np.abs(a0) >= rule.min_a0_weight
-    # first candidate; if none qualifies, the eigenvector with the largest y(n) component
-    first = np.where(cand.any(axis=1), np.argmax(cand, axis=1), np.argmax(np.abs(a0), axis=1))
+    a0w, out_w = weights  # unit-free weights (k, p)
+    cand = a0w >= rule.min_a0_weight
+    # first candidate; if none qualifies, the eigenvector with the largest y(n) weight
+    first = np.where(cand.any(axis=1), np.argmax(cand, axis=1), np.argmax(a0w, axis=1))
     floor = rule.zero_tol * np.maximum(vals[:, -1], 0.0)
     lam_s = np.maximum(vals[np.arange(k), first], floor)
     within = (np.maximum(vals, 0.0) <= ratio[:, None] * lam_s[:, None]) | (
@@ -339,6 +352,7 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
             noise_cov=noise,
             rule=a.rule,
             data=centered if rows.shape[1] >= p else None,  # SVD needs rows >= columns
+            scaling=a.scaling,
         )
         out["theta_estimate"].append(res.theta)
         out["eigenvalues"].append(res.eigenvalues)

@@ -417,19 +417,32 @@ def noisy_siso(siso2, rich_input):
 
 
 @pytest.mark.parametrize("k", [1e-3, 7.5, -2.0])
-def test_scaling_u_scales_the_numerator_by_one_over_k(noisy_siso, k):
+def test_std_scaling_u_scales_the_numerator_by_one_over_k(noisy_siso, k):
+    # scaling="std" is the unit-free option: rescaling u rescales b, nothing else
     u, y = noisy_siso
-    base = LPC(order=2).fit(u, y)
-    scaled = LPC(order=2).fit(k * u, y)
+    base = LPC(order=2, scaling="std").fit(u, y)
+    scaled = LPC(order=2, scaling="std").fit(k * u, y)
     np.testing.assert_allclose(scaled.den, base.den, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(scaled.num, base.num / k, rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize("k", [1e-3, 7.5, -2.0])
-def test_scaling_y_scales_the_numerator_by_k(noisy_siso, k):
+def test_default_is_unit_free_on_noise_free_data(k):
+    # the raw-units default is TLS: it depends on units only through the noise; without
+    # noise every scaling gives the exact system
+    rng = np.random.default_rng(11)
+    u = rng.standard_normal(3000)
+    y = clpc.simulate_arx([1.0, -1.5, 0.7], [0.2, 0.5, 0.1], u)
+    scaled = LPC(order=2).fit(k * u, y)
+    np.testing.assert_allclose(scaled.den, [1.0, -1.5, 0.7], atol=1e-9)
+    np.testing.assert_allclose(scaled.num * k, [0.2, 0.5, 0.1], atol=1e-9)
+
+
+@pytest.mark.parametrize("k", [1e-3, 7.5, -2.0])
+def test_std_scaling_y_scales_the_numerator_by_k(noisy_siso, k):
     u, y = noisy_siso
-    base = LPC(order=2).fit(u, y)
-    scaled = LPC(order=2).fit(u, k * y)
+    base = LPC(order=2, scaling="std").fit(u, y)
+    scaled = LPC(order=2, scaling="std").fit(u, k * y)
     np.testing.assert_allclose(scaled.den, base.den, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(scaled.num, base.num * k, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(scaled.intercept, base.intercept * k, rtol=1e-9, atol=1e-12)

@@ -15,14 +15,7 @@ import numpy as np
 
 from clpc.appraiser import kernel
 from clpc.core.jit import compiled, numba_available
-from clpc.core.rules import (
-    CHANNEL_SCALES,
-    FIXED_TRANSFORM,
-    NO_TRANSFORM,
-    RobustRule,
-    SolveSettings,
-    solve_settings,
-)
+from clpc.core.rules import RobustRule, SolveSettings, solve_settings, transform_mode
 from clpc.lpc.solve import fixed_transform
 from clpc.model.structure import Structure
 
@@ -99,16 +92,19 @@ def window_plan(
 
 
 def settings_for(
-    method: str, rule: RobustRule, noise: np.ndarray | None, na: int, n_channels: int
+    method: tuple[str, str],
+    rule: RobustRule,
+    noise: np.ndarray | None,
+    na: int,
+    n_channels: int,
 ) -> SolveSettings:
-    """The solve settings of an appraiser (see :func:`clpc.core.rules.solve_settings`)."""
-    if noise is not None:
-        mode = FIXED_TRANSFORM
-    elif method == "robust":
-        mode = CHANNEL_SCALES
-    else:
-        mode = NO_TRANSFORM
-    return solve_settings(rule, method == "robust", mode, na + 1, n_channels)
+    """The solve settings of an appraiser: ``method = (method, scaling)``.
+
+    See :func:`clpc.core.rules.solve_settings` and :func:`clpc.core.rules.transform_mode`.
+    """
+    name, scaling = method
+    mode = transform_mode(scaling, noise is not None)
+    return solve_settings(rule, name == "robust", mode, na + 1, n_channels)
 
 
 class Engine:

@@ -42,7 +42,7 @@ from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup
 from clpc.core.checks import check_choice, check_int, check_positive
-from clpc.core.rules import RobustRule
+from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError, IOData, as_iodata
 from clpc.model.structure import Structure
 
@@ -67,7 +67,7 @@ class CLPC:
         Alias of ``cluster_size``.
     na, nb, nk : int, optional
         Separate orders and input delay (override ``parameters_size``).
-    method, noise_ratio, noise_cov, rule
+    method, scaling, noise_ratio, noise_cov, rule
         LPC options (see :class:`clpc.LPC`).
     mimo : {"siso", "paired", "miso"}, optional
         Multi-channel structure (default ``"siso"`` for 1x1 data, else ``"miso"``).
@@ -102,6 +102,7 @@ class CLPC:
         nb: int | None = None,
         nk: int = 0,
         method: str = "robust",
+        scaling: str = "none",
         mimo: str | None = None,
         noise_ratio: float | None = None,
         noise_cov: Any = None,
@@ -126,6 +127,7 @@ class CLPC:
         order = self.parameters_size - 1
         self.structure = Structure(order if na is None else na, order if nb is None else nb, nk)
         self.method = check_choice(method, "method", ("robust", "paper"))
+        self.scaling = check_choice(scaling, "scaling", SCALINGS)
         self.mimo = mimo
         self.noise_ratio = noise_ratio
         self.noise_cov = None if noise_cov is None else np.asarray(noise_cov, dtype=float)
@@ -351,7 +353,8 @@ class CLPC:
         return (
             f"CLPC(parameters_size={self.parameters_size}, window_size={self.window_size}, "
             f"cluster_size={self.cluster_size}, sample_time={self.sample_time}, "
-            f"method={self.method!r}, samples_seen={self._n_seen}, updates={self._j_done})"
+            f"method={self.method!r}, scaling={self.scaling!r}, "
+            f"samples_seen={self._n_seen}, updates={self._j_done})"
         )
 
 

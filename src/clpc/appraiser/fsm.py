@@ -103,7 +103,7 @@ def kernel_setup(a: Any) -> KernelSetup:
         a._setup = KernelSetup(
             engine=Engine(a.engine),
             plan=plan,
-            settings=settings_for(a.method, a.rule, cov, s.na, n_channels),
+            settings=settings_for((a.method, a.scaling), a.rule, cov, s.na, n_channels),
             fsm=kernel.FsmSettings(
                 min_rows(a), a.gate, a.rule.separation, s.na, s.nb, s.nk, not miso
             ),

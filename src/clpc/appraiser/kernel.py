@@ -35,7 +35,6 @@ import numpy as np
 from clpc.core.jit import kernel
 from clpc.core.polynomials import monic, schur_stable
 from clpc.core.rules import (
-    CHANNEL_SCALES,
     NO_TRANSFORM,
     SolveSettings,
     accepts,
@@ -254,8 +253,7 @@ def solve_one(
         for b in range(p):
             if not math.isfinite(scat[a, b]):
                 finite = False
-    if s.transform_mode == CHANNEL_SCALES:
-        channel_scales(scat, n_rows, plan.col_channel, s.n_channels, scales)
+    channel_scales(scat, n_rows, plan.col_channel, s.n_channels, scales)
     solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
     ok = finite and sym_eig(mat, vals, vecs, ework, True)
     if ok and s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself
@@ -269,7 +267,14 @@ def solve_one(
             eigenvalues[a] = 0.0
         return 0.0, 0.0, 1.0, 0.0, 1, 0, True
     return solve_from_eig(
-        scat, mean, n_rows, (vals, vecs, raw), tmat, s, plan.col_channel, (phi, theta, eigenvalues)
+        scat,
+        mean,
+        n_rows,
+        (vals, vecs, raw),
+        (tmat, scales),
+        s,
+        plan.col_channel,
+        (phi, theta, eigenvalues),
     )
 
 

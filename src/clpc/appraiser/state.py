@@ -41,6 +41,7 @@ def config_of(a: Any) -> dict[str, Any]:
         "nb": a.structure.nb,
         "nk": a.structure.nk,
         "method": a.method,
+        "scaling": a.scaling,
         "mimo": a.mimo,
         "noise_ratio": a.noise_ratio,
         "noise_cov": None if a.noise_cov is None else a.noise_cov.tolist(),

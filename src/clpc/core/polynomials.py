@@ -126,3 +126,76 @@ def stable_many(den: np.ndarray) -> np.ndarray:
     if flat.shape[0]:
         compiled(_stable_rows)(flat, out)
     return out.reshape(den.shape[:-1])
+
+
+#: A pole and a zero closer than this (in the z-plane) are one common factor: total least
+#: squares at an order above the system's puts the extra factor of both polynomials near
+#: the unit circle (a Pisarenko effect), and the pair is then cancelled.
+CANCEL_DISTANCE = 0.02
+
+
+def _factor(root: complex) -> np.ndarray:
+    """``(1 - r z^-1)``, or ``(1 - r z^-1)(1 - conj(r) z^-1)`` for a complex ``r``."""
+    if abs(root.imag) > 0:
+        return np.array([1.0, -2.0 * root.real, abs(root) ** 2])
+    return np.array([1.0, -root.real])
+
+
+def _pairs(den: np.ndarray, nums: list[np.ndarray], tol: float) -> list[complex]:
+    """Poles of ``den`` within ``tol`` of a zero of every nonzero numerator (one per conj pair)."""
+    poles = np.roots(den)
+    zero_sets = [np.roots(np.trim_zeros(b, "f")) for b in nums if np.any(b != 0)]
+    if not zero_sets or any(z.size == 0 for z in zero_sets):
+        return []
+    found: list[complex] = []
+    used = [np.zeros(z.size, dtype=bool) for z in zero_sets]
+    for p in sorted(poles, key=lambda r: -abs(r)):  # outermost first: the spurious ones
+        if p.imag < 0:
+            continue  # handled with its conjugate
+        hits = []
+        for z, u in zip(zero_sets, used, strict=True):
+            d = np.where(u, np.inf, np.abs(z - p))
+            hits.append(int(np.argmin(d)) if d.min() < tol else -1)
+        if min(hits) < 0:
+            continue
+        for h, u, z in zip(hits, used, zero_sets, strict=True):
+            u[h] = True
+            if p.imag > 0:  # the conjugate zero too
+                u[int(np.argmin(np.where(u, np.inf, np.abs(z - np.conj(p)))))] = True
+        found.append(complex(p))
+    return found
+
+
+def cancel_common_factors(
+    den: np.ndarray, nums: np.ndarray, tol: float = CANCEL_DISTANCE
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Remove pole/zero pairs closer than ``tol`` from one equation's monic polynomials.
+
+    Parameters
+    ----------
+    den : ndarray, shape (na + 1,)
+        Monic ``A(z)``, ascending powers of ``z^-1``.
+    nums : ndarray, shape (n_inputs, nk + nb + 1)
+        Numerators with ``nk`` leading zeros (an all-zero row is an input the equation
+        does not use).
+    tol : float
+        Largest pole-zero distance that counts as a common factor.
+
+    Returns
+    -------
+    den, nums, removed
+        The reduced polynomials (``na - removed + 1`` and ``nk + nb - removed + 1``
+        coefficients) and the number of first-order factors removed.
+    """
+    roots = _pairs(np.asarray(den, float), [np.asarray(b, float) for b in nums], tol)
+    den = np.asarray(den, float)
+    nums = np.asarray(nums, float)
+    removed = 0
+    for r in roots:
+        f = _factor(r)
+        den = np.polydiv(den, f)[0].real
+        nums = np.array(
+            [np.polydiv(b, f)[0].real if np.any(b != 0) else b[: -f.size + 1] for b in nums]
+        )
+        removed += f.size - 1
+    return den, nums, removed

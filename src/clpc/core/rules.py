@@ -35,6 +35,7 @@ __all__ = [
     "degeneracy_ratio",
     "is_determined",
     "solve_from_eig",
+    "transform_mode",
 ]
 
 # ------------------------------------------------------------------ named thresholds
@@ -113,6 +114,27 @@ class SolveSettings(NamedTuple):
     degeneracy_ratio: float  #: <= 0: the Marchenko-Pastur ratio
     zero_tol: float
     min_output_weight: float
+
+
+#: the choices of ``scaling``: the raw units of the data (the default: consistent under
+#: errors-in-variables) or each channel divided by its standard deviation
+SCALINGS = ("none", "std")
+
+
+def transform_mode(scaling: str, has_noise_cov: bool) -> int:
+    """The solved problem: a known noise covariance wins, else ``scaling``.
+
+    ``"none"`` solves ``A`` in the data's units: total least squares, consistent when the
+    noise on every lag entry has the same variance (errors-in-variables with equal noise,
+    the case TLS exists for). ``"std"`` solves ``S^-1 A S^-1`` with ``S`` the channels'
+    standard deviations: unit-free, but consistent only when every channel has the same
+    signal-to-noise ratio.
+    """
+    if scaling not in SCALINGS:
+        raise ValueError(f"scaling must be 'none' or 'std'; got {scaling!r}.")
+    if has_noise_cov:
+        return FIXED_TRANSFORM
+    return CHANNEL_SCALES if scaling == "std" else NO_TRANSFORM
 
 
 def solve_settings(
@@ -249,49 +271,82 @@ def ratio(num: float, den: float) -> float:
 
 # ------------------------------------------------------------------ picking the vector
 @kernel
-def _output_weight(vecs: np.ndarray, i: int, n_out_cols: int) -> float:
-    wy = 0.0
-    for a in range(n_out_cols):
-        wy += vecs[a, i] ** 2
-    return wy
+def unit_free_weights(
+    vec: np.ndarray, tmat: np.ndarray, scales: np.ndarray, n_out_cols: int
+) -> tuple[float, float]:
+    """The ``y(n)`` weight and the output-block weight of ``theta = T v``, free of units.
+
+    With ``s`` the channels' standard deviations (per column), ``w = diag(s) T v`` is the
+    relation in units of each channel's own spread: ``|w_0| / ||w||`` (the ``y(n)``
+    weight) and ``||w_y||^2 / ||w||^2`` (the output block's share) do not change when a
+    channel is rescaled. An input-only relation has ``y(n)`` weight 0 in any units.
+    """
+    p = vec.shape[0]
+    total = 0.0
+    out = 0.0
+    first = 0.0
+    for a in range(p):
+        acc = 0.0
+        for b in range(p):
+            acc += tmat[a, b] * vec[b]
+        w = scales[a] * acc
+        total += w * w
+        if a < n_out_cols:
+            out += w * w
+        if a == 0:
+            first = abs(w)
+    if not total > 0:
+        return 0.0, 0.0
+    return first / math.sqrt(total), out / total
 
 
 @kernel
 def pick_paper(
-    vals: np.ndarray, vecs: np.ndarray, s: SolveSettings, phi: np.ndarray
+    eig: tuple[np.ndarray, np.ndarray],
+    weights: tuple[np.ndarray, np.ndarray],
+    s: SolveSettings,
+    phi: np.ndarray,
 ) -> tuple[int, int, float]:
     """The literal last principal component; returns ``(n_null, n_input, separation)``."""
+    vals, vecs = eig
     p = vals.shape[0]
     for a in range(p):
         phi[a] = vecs[a, 0]
-    n_input = 1 if _output_weight(vecs, 0, s.n_out_cols) < s.min_output_weight else 0
+    n_input = 1 if weights[1][0] < s.min_output_weight else 0
     return 1, n_input, ratio(vals[0], vals[1] if p > 1 else vals[0])
 
 
 @kernel
 def pick_robust(
-    vals: np.ndarray, vecs: np.ndarray, s: SolveSettings, n_rows: float, phi: np.ndarray
+    eig: tuple[np.ndarray, np.ndarray],
+    weights: tuple[np.ndarray, np.ndarray],
+    s: SolveSettings,
+    n_rows: float,
+    phi: np.ndarray,
 ) -> tuple[int, int, float]:
     """Minimum-norm ``a0 = 1`` vector in the near-null subspace of the solved problem.
 
-    The first eigenvector (ascending) with ``|v[a0]| >= min_a0_weight`` is the candidate
-    (none: the one with the largest ``|v[a0]|``); the near-null subspace runs from the
-    smallest eigenvalue through every eigenvalue within the degeneracy ratio of the
-    candidate's; ``phi`` is the projection of ``e_a0`` onto it. Returns ``(n_null,
-    n_input, separation)``.
+    ``weights = (a0_weights, output_weights)`` of each eigenvector, unit-free
+    (:func:`unit_free_weights`). The first eigenvector (ascending) whose ``y(n)`` weight
+    is at least ``min_a0_weight`` is the candidate (none: the one with the largest); the
+    near-null subspace runs from the smallest eigenvalue through every eigenvalue within
+    the degeneracy ratio of the candidate's; ``phi`` is the projection of ``e_a0`` onto it.
+    Returns ``(n_null, n_input, separation)``.
     """
+    vals, vecs = eig
+    a0w, outw = weights
     p = vals.shape[0]
     lim = degeneracy_ratio(s.degeneracy_ratio, p, n_rows)
     first = -1
     for i in range(p):
-        if abs(vecs[0, i]) >= s.min_a0_weight:
+        if a0w[i] >= s.min_a0_weight:
             first = i
             break
     if first < 0:
         best = -1.0
         for i in range(p):
-            if abs(vecs[0, i]) > best:
-                best = abs(vecs[0, i])
+            if a0w[i] > best:
+                best = a0w[i]
                 first = i
     lam_s = max(vals[first], s.zero_tol * max(vals[p - 1], 0.0))
     last = p - 1
@@ -306,7 +361,7 @@ def pick_robust(
         w = vecs[0, i]
         for a in range(p):
             phi[a] += vecs[a, i] * w
-        if _output_weight(vecs, i, s.n_out_cols) < s.min_output_weight:
+        if outw[i] < s.min_output_weight:
             n_input += 1
     separation = 1.0 if last + 1 >= p else ratio(lam_s, vals[last + 1])
     return last + 1, n_input, separation
@@ -337,7 +392,7 @@ def solve_from_eig(
     mean: np.ndarray,
     n_rows: float,
     eig: tuple[np.ndarray, np.ndarray, np.ndarray],
-    tmat: np.ndarray,
+    transform: tuple[np.ndarray, np.ndarray],
     s: SolveSettings,
     col_channel: np.ndarray,
     out: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -353,8 +408,9 @@ def solve_from_eig(
     eig : (vals, vecs, raw)
         Ascending eigenvalues (p,) and eigenvectors (columns, (p, p)) of ``T^T A T``, and
         the ascending eigenvalues of ``A`` itself (the paper's, for ``D``).
-    tmat : ndarray, shape (p, p)
-        ``T``.
+    transform : (tmat, scales)
+        ``T`` (p, p), and the channels' standard deviations per column (p,) that make the
+        weights of :func:`unit_free_weights` unit-free.
     s : SolveSettings
     col_channel : ndarray of int, shape (p,)
         Channel block of each column (0 = output).
@@ -368,18 +424,19 @@ def solve_from_eig(
         ``(c, noise_variance, separation, a0_weight, n_null, n_input, degenerate)``.
     """
     vals, vecs, raw = eig
+    tmat, scales = transform
     phi, theta, eigenvalues = out
     p = scat.shape[0]
     degenerate = is_degenerate(scat, mean, n_rows, max(raw[p - 1], 0.0), col_channel, s.n_channels)
+    a0w = np.empty(p)
+    outw = np.empty(p)
+    for i in range(p):
+        a0w[i], outw[i] = unit_free_weights(vecs[:, i], tmat, scales, s.n_out_cols)
     if s.robust:
-        n_null, n_input, separation = pick_robust(vals, vecs, s, n_rows, phi)
+        n_null, n_input, separation = pick_robust((vals, vecs), (a0w, outw), s, n_rows, phi)
     else:
-        n_null, n_input, separation = pick_paper(vals, vecs, s, phi)
-    norm = 0.0
-    for a in range(p):
-        norm += phi[a] * phi[a]
-    norm = math.sqrt(norm)
-    a0_weight = 0.0 if degenerate else abs(phi[0]) / (norm if norm > 0 else 1.0)
+        n_null, n_input, separation = pick_paper((vals, vecs), (a0w, outw), s, phi)
+    a0_weight = 0.0 if degenerate else unit_free_weights(phi, tmat, scales, s.n_out_cols)[0]
     for a in range(p):  # theta = T phi
         acc = 0.0
         for b in range(p):

@@ -18,6 +18,7 @@ import numpy as np
 
 from clpc.core import rules
 from clpc.data import DataError, IOData, as_iodata
+from clpc.lpc.reduction import reduce_model
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
 from clpc.lpc.solve import RobustRule, SolveResult, solve_scatter
 from clpc.model import LinearModel
@@ -41,6 +42,7 @@ def lpc_solve(
     method: str = "robust",
     noise_cov: np.ndarray | None = None,
     rule: RobustRule | None = None,
+    scaling: str = "none",
 ) -> SolveResult:
     """LPC of one or more lag matrices (rows are lag vectors ``z_n``).
 
@@ -48,8 +50,8 @@ def lpc_solve(
     ----------
     matrices : ndarray, shape (k, n_rows, p)
         Lag matrices (paper eq. 36), e.g. from :func:`clpc.regressors.regressors`.
-    n_output_cols, blocks, method, noise_cov, rule
-        See :func:`clpc.solve.solve_scatter`.
+    n_output_cols, blocks, method, noise_cov, rule, scaling
+        See :func:`clpc.lpc.solve.solve_scatter`.
 
     Returns
     -------
@@ -72,6 +74,7 @@ def lpc_solve(
         noise_cov=noise_cov,
         rule=rule,
         data=centered,
+        scaling=scaling,
     )
 
 
@@ -80,7 +83,8 @@ def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str
 
     Keys: ``eigenvalues``, ``lambda_min``, ``lambda_max``, ``D`` (``lambda_max -
     lambda_min``, the paper's degree of linearity), ``eig_ratio`` (``lambda_min /
-    lambda_max``, scale-free), ``separation``, ``c``, ``noise_variance``,
+    lambda_max``, scale-free), ``separation``, ``a0_weight`` (the unit-free ``y(n)``
+    weight of the solution), ``c``, ``noise_variance``,
     ``log_likelihood``, ``J`` (eq. 22), ``n_rows``, ``n_null``, ``n_input_relations``,
     ``degenerate``, ``determined``. Each number comes from :mod:`clpc.core.rules`, the
     functions the CLPC kernel compiles.
@@ -107,6 +111,7 @@ def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str
             [rules.eig_ratio(lo, hi) for lo, hi in zip(lam_min, lam_max, strict=True)]
         ),
         "separation": res.separation,
+        "a0_weight": res.a0_weight,
         "c": res.c,
         "noise_variance": res.noise_variance,
         "log_likelihood": np.array(
@@ -135,8 +140,16 @@ class LPC:
         Input delay in samples (default 0: ``b0`` present, as in the paper).
     method : {"robust", "paper"}
         ``"paper"``: the literal smallest eigenvector of the scatter matrix.
-        ``"robust"`` (default): unit-free scaling and the excitation-aware nongeneric
-        TLS solution (see :mod:`clpc.solve`).
+        ``"robust"`` (default): the excitation-aware nongeneric TLS solution - relations
+        that do not involve ``y(n)`` (judged unit-free) are set aside and the minimum-norm
+        ``a0 = 1`` vector of the near-null subspace is taken (:mod:`clpc.core.rules`).
+    scaling : {"none", "std"}
+        ``"none"`` (default): solve in the data's units - total least squares, consistent
+        under errors-in-variables with equal noise variances on every lag entry.
+        ``"std"``: divide each channel by its standard deviation first - unit-free, but
+        consistent only when all channels have the same signal-to-noise ratio. For a known
+        noise model use ``noise_ratio``/``noise_cov``; for exact inputs with noise on the
+        output only, least squares (:class:`clpc.ARX`) is the right estimator.
     mimo : {"siso", "paired", "miso"}, optional
         Multi-channel structure; default ``"siso"`` for 1x1 data, else ``"miso"``.
         ``"paired"`` is the paper's eqs. 35-38 (output j on input j only).
@@ -147,6 +160,11 @@ class LPC:
         ``noise_ratio``).
     rule : RobustRule, optional
         Thresholds of the robust solution.
+    cancel : bool
+        Remove pole/zero pairs closer than 0.02 (default ``True``): at an order above the
+        system's, TLS puts the extra common factor near the unit circle. The model then
+        has the reduced structure and ``info["cancelled"]`` counts the removed factors
+        (:mod:`clpc.lpc.reduction`).
 
     Notes
     -----
@@ -158,10 +176,12 @@ class LPC:
     nb: int | None = None
     nk: int = 0
     method: str = "robust"
+    scaling: str = "none"
     mimo: MimoMode | None = None
     noise_ratio: float | None = None
     noise_cov: Any = None
     rule: RobustRule | None = None
+    cancel: bool = True
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
@@ -219,11 +239,15 @@ class LPC:
             method=self.method,
             noise_cov=self._noise_cov(structure, n_blocks),
             rule=rule,
+            scaling=self.scaling,
         )
         _raise_if_degenerate(res, data)
         info = fit_info(res, np.full(mats.shape[0], mats.shape[1]), rule)
         info["method"] = self.method
-        return LinearModel(
+        info["scaling"] = (
+            self.scaling if self.noise_cov is None and self.noise_ratio is None else "noise"
+        )
+        model = LinearModel(
             theta=res.theta,
             structure=structure,
             n_inputs=data.n_inputs,
@@ -234,6 +258,7 @@ class LPC:
             output_names=data.output_names,
             info=info,
         )
+        return reduce_model(model, data) if self.cancel else model
 
 
 def _raise_if_degenerate(res: SolveResult, data: IOData) -> None:

@@ -120,7 +120,8 @@ def select_order(
     largest = replace(base, order=int(orders[-1]), na=None, nb=None).structure().max_lag
     rows = []
     for order in orders:
-        est = replace(base, order=int(order), na=None, nb=None)
+        # the likelihood table compares the orders as fitted (no cancellation)
+        est = replace(base, order=int(order), na=None, nb=None, cancel=False)
         skip = largest - est.structure().max_lag  # drop samples so all use the same rows
         model = est.fit(data[skip:])
         info = model.info

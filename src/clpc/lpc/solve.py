@@ -30,8 +30,6 @@ import numpy as np
 from clpc.core import rules
 from clpc.core.jit import compiled
 from clpc.core.rules import (
-    CHANNEL_SCALES,
-    FIXED_TRANSFORM,
     NO_TRANSFORM,
     ROUNDING_VARIANCE_FACTOR,
     RobustRule,
@@ -107,6 +105,7 @@ def solve_scatter(
     noise_cov: np.ndarray | None = None,
     rule: RobustRule | None = None,
     data: np.ndarray | None = None,
+    scaling: str = "none",
 ) -> SolveResult:
     """Solve a stack of LPC problems given their scatter matrices.
 
@@ -133,6 +132,8 @@ def solve_scatter(
     data : ndarray, shape (k, n, p), optional
         Centered data matrices; when given (one-shot fits) the decomposition is the SVD of
         the data, which is more accurate than the eigen-decomposition of the scatter.
+    scaling : {"none", "std"}
+        The solved problem without a noise covariance (:func:`clpc.core.rules.transform_mode`).
 
     Returns
     -------
@@ -145,11 +146,8 @@ def solve_scatter(
     mean = np.ascontiguousarray(mean, dtype=np.float64)
     k, p, _ = scatter.shape
     n_rows_f = np.asarray(n_rows, dtype=np.float64) * np.ones(k)
-    if noise_cov is not None:
-        mode, fixed = FIXED_TRANSFORM, fixed_transform(noise_cov, p)
-    else:
-        mode = CHANNEL_SCALES if method == "robust" else NO_TRANSFORM
-        fixed = np.eye(p)
+    mode = rules.transform_mode(scaling, noise_cov is not None)
+    fixed = np.eye(p) if noise_cov is None else fixed_transform(noise_cov, p)
     settings = solve_settings(rule_, method == "robust", mode, n_output_cols, len(blocks))
     col_channel = _column_channels(blocks, p)
     scales_of, matrix_of = engine_fn(rules.channel_scales), engine_fn(rules.solved_matrix)
@@ -164,8 +162,7 @@ def solve_scatter(
     }
     for i in range(k):
         scales, tmat, mat = np.ones(p), np.empty((p, p)), np.empty((p, p))
-        if mode == CHANNEL_SCALES:
-            scales_of(scatter[i], n_rows_f[i], col_channel, len(blocks), scales)
+        scales_of(scatter[i], n_rows_f[i], col_channel, len(blocks), scales)
         matrix_of(scatter[i], mode, fixed, scales, tmat, mat)
         vals, vecs, raw = _decompose(
             mat, tmat, scatter[i], None if data is None else data[i], mode == NO_TRANSFORM
@@ -175,7 +172,7 @@ def solve_scatter(
             mean[i],
             n_rows_f[i],
             (vals, vecs, raw),
-            tmat,
+            (tmat, scales),
             settings,
             col_channel,
             (np.empty(p), out["theta"][i], out["eigenvalues"][i]),

@@ -77,7 +77,16 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             "linear relation(s) by itself (e.g. a smooth or ramp-like input); the input part "
             "of the model is the minimum-norm choice and may not describe other inputs"
         )
-    if n_null - n_input > 1:
+    cancelled = int(info.get("cancelled", 0))
+    if cancelled:
+        fitted = info.get("fitted_structure", {})
+        na, nb = fitted.get("na"), fitted.get("nb")
+        msgs.append(
+            f"order larger than the data support: {cancelled} pole/zero factor(s) common to "
+            f"A and B (closer than 0.02) were cancelled; fitted na={na}, nb={nb}, kept "
+            f"na={model.structure.na}, nb={model.structure.nb}"
+        )
+    elif n_null - n_input > 1:
         msgs.append(
             f"{n_null - n_input} output relations are equally small: the order may be larger "
             "than the system's (common pole-zero factors); consider a lower order"
