@@ -333,6 +333,18 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
     if noise is None and a.noise_ratio is not None:
         noise = np.concatenate([np.ones(na1), np.full(n_blocks * nb1, float(a.noise_ratio))])
     n_updates = mats.shape[1] // a.cluster_size
+    # each channel's running quantization step: the smallest nonzero change so far
+    samples = np.hstack([u2, y2])
+    change = np.abs(np.diff(samples, axis=0, prepend=samples[:1]))
+    change[~(change > 0)] = np.inf
+    step = np.minimum.accumulate(change, axis=0)
+    col_chan = []
+    for e in range(n_out):
+        cols = [n_in + e] * na1
+        for i in range(n_in) if mode == "miso" else [e]:
+            cols += [i] * nb1
+        col_chan.append(cols)
+    excited = []
     out: dict[str, list[Any]] = {k: [] for k in ("theta_estimate", "eigenvalues", "c", "rows")}
     for key in ("noise_variance", "separation", "a0_weight", "n_null", "n_input", "degenerate"):
         out[key] = []
@@ -354,6 +366,10 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
             data=centered if rows.shape[1] >= p else None,  # SVD needs rows >= columns
             scaling=a.scaling,
         )
+        std = np.sqrt(np.diagonal(scatter, axis1=1, axis2=2) / rows.shape[1])
+        newest = s.max_lag + end - 1
+        quanta = np.array([step[newest, col_chan[e]] for e in range(n_out)])
+        excited.append(np.all(std >= 3.0 * quanta, axis=1))
         out["theta_estimate"].append(res.theta)
         out["eigenvalues"].append(res.eigenvalues)
         out["c"].append(res.c)
@@ -373,9 +389,11 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
         & (arr["separation"] <= a.rule.separation)
         & ~arr["degenerate"]
     )
+    need = a.trust_rows or min(max(10 * p, int(np.ceil(0.5 * a.window_size))), a.window_size)
+    trusted = (arr["rows"][:, None] >= need) & np.array(excited) & determined
     accepted = ~not_enough[:, None] & ~arr["degenerate"] & (arr["a0_weight"] >= 1e-3)
-    if a.gate:
-        accepted &= determined
+    if a.guard:
+        accepted &= trusted
     idx = np.where(accepted, np.arange(n_updates)[:, None], -1)
     last = np.maximum.accumulate(idx, axis=0)
     have = last >= 0
@@ -407,6 +425,7 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
         "has_model": have,
         "degenerate": arr["degenerate"],
         "determined": determined,
+        "trusted": trusted,
         "n_null": arr["n_null"],
         "n_input_relations": arr["n_input"],
         "stable": stable,

@@ -87,7 +87,7 @@ def test_outputs_hold_between_updates():
 
 def test_not_enough_data_is_flagged_and_not_used():
     u, y = record(300)
-    trace = CLPC(3, 201, 4).run(u, y)
+    trace = CLPC(3, 201, 4, guard=False).run(u, y)  # the paper's appraiser: no guard
     p = 6
     assert np.all(trace.not_enough_data == (trace.rows < 2 * p))
     first_ok = np.flatnonzero(~trace.not_enough_data)[0]
@@ -117,7 +117,7 @@ def test_unconverged_steady_state_raises():
     rng = np.random.default_rng(3)
     u = rng.standard_normal(800)
     y = rng.standard_normal(800)  # no relation at all: parameters wander
-    trace = CLPC(3, 30, 6).run(u, y)
+    trace = CLPC(3, 30, 6, guard=False).run(u, y)
     conv = trace.convergence(theta_tol=1e-6, D_tol=1e-6)
     assert not conv.converged
     with pytest.raises(ValueError, match="never became quasi-constant"):
@@ -430,3 +430,58 @@ def test_small_clusters_prefix_path_is_exact_and_streams(cluster):
     streamed = Trace.concat(parts)
     np.testing.assert_allclose(streamed.theta, trace.theta, atol=1e-10)
     np.testing.assert_allclose(streamed.D, trace.D, rtol=1e-10)
+
+
+# ---------------------------------------------------------------- the guard
+def test_guard_accepts_only_trusted_windows():
+    u, y = record(3000, seed=21, noise=0.01)
+    guarded = CLPC(3, 201, 12).run(u, y)
+    assert guarded.meta["guard"]
+    accepted = guarded.arrays["accepted"][:, 0]
+    trusted = guarded.arrays["trusted"][:, 0]
+    assert accepted.any() and not (accepted & ~trusted).any()
+    # a trusted window holds max(10 p, W / 2) = 101 rows here
+    assert not (trusted & (guarded.rows < 101)).any()
+    determined = guarded.arrays["determined"][:, 0]
+    assert (trusted == (guarded.rows >= 101) & determined).all()
+
+
+def test_guard_never_holds_a_model_from_a_quantized_start_up_window():
+    # a quantized output that moves by one step in the first windows: a handful of values
+    # satisfy exact relations (eigenvalue ~ 0, "determined"); the guard refuses them
+    rng = np.random.default_rng(22)
+    u = rng.standard_normal(2000)
+    y = clpc.simulate_arx(DEN, NUM, u)
+    y[:300] = 0.0
+    y[150:300] = 1.0  # one quantization step, then the real signal
+    step = 1e-2
+    y = np.round(y / step) * step
+    paper = CLPC(3, 201, 12, guard=False).run(u, y)
+    guarded = CLPC(3, 201, 12).run(u, y)
+    early = guarded.index < 300
+    assert paper.arrays["accepted"][early].any()
+    assert not guarded.arrays["accepted"][early].any()
+    assert not guarded.arrays["excited"][early].any() or not guarded.arrays["trusted"][early].any()
+
+
+def test_no_relation_nothing_trusted_and_no_convergence():
+    rng = np.random.default_rng(23)
+    u, y = rng.standard_normal(3000), rng.standard_normal(3000)
+    trace = CLPC(3, 201, 12).run(u, y)
+    assert not trace.arrays["trusted"].any() and not trace.has_model.any()
+    conv = trace.convergence(theta_tol=10.0, D_tol=10.0)  # tolerances that anything meets
+    assert not conv.converged and conv.trusted_fraction == 0.0
+    assert "windows are trusted" in conv.reason
+    with pytest.raises(ValueError, match="trusted"):
+        trace.steady_state_model(conv)
+    words = clpc.describe_trace(trace)
+    assert any("0 of" in w and "trusted" in w for w in words)
+
+
+def test_guard_settings_are_checked_and_saved(tmp_path):
+    with pytest.raises(ValueError, match="guard must be True or False"):
+        CLPC(guard="no")
+    a = CLPC(3, 60, 6, guard=False, trust_rows=30)
+    assert CLPC.from_state_dict(a.state_dict()).trust_rows == 30
+    assert not CLPC.from_state_dict(a.state_dict()).guard
+    assert CLPC(gate=False).guard is False  # the former name

@@ -29,6 +29,7 @@ FLAG_KEYS = (
     "has_model",
     "degenerate",
     "determined",
+    "trusted",
     "n_null",
     "n_input_relations",
     "stable",

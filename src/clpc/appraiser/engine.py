@@ -126,7 +126,7 @@ class Engine:
 
     def solve(
         self,
-        samples: np.ndarray,
+        samples: tuple[np.ndarray, np.ndarray],
         first_row: int,
         windows: tuple[int, int],
         plan: kernel.WindowPlan,
@@ -145,6 +145,7 @@ class Engine:
             n_null=np.empty((count, e), dtype=np.int64),
             n_input_relations=np.empty((count, e), dtype=np.int64),
             degenerate=np.empty((count, e), dtype=np.bool_),
+            excited=np.empty((count, e), dtype=np.bool_),
             n_rows=np.empty(count, dtype=np.int64),
         )
         self._solve(samples, first_row, windows, plan, settings, out)
@@ -168,6 +169,7 @@ class Engine:
             accepted=b(e),
             has_model=b(e),
             determined=b(e),
+            trusted=b(e),
             not_enough=b(),
             den=f(e, fs.na + 1),
             num=f(e, n_inputs, fs.nk + fs.nb + 1),

@@ -13,8 +13,9 @@ Semantics (``docs/clpc.md`` says the same):
   vector ``m = C j`` and uses rows ``[max(0, m - W), m)``; its ``index`` is the newest
   sample, ``k = max_lag + m - 1``.
 * An update with fewer than ``min_rows`` rows is flagged ``not_enough_data``; degenerate
-  windows (nothing varies, a constant channel) are flagged ``degenerate``; with ``gate=True``
-  an estimate the window does not determine (see :mod:`clpc.core.rules`) is not accepted. An
+  windows (nothing varies, a constant channel) are flagged ``degenerate``; with the guard (the
+  default) only a *trusted* window's estimate is accepted: enough rows, channels excited
+  above their quantization, a solution the data determine (see :mod:`clpc.core.rules`). An
   update that is not accepted holds the last accepted parameters; parameters are never NaN
   (zeros, with ``has_model=False``, until a first estimate is accepted).
 * ``sample_time``: data sampled faster by an integer factor are low-pass filtered (causal
@@ -41,7 +42,7 @@ from clpc.appraiser.engine import resolve_engine
 from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup
-from clpc.core.checks import check_choice, check_int, check_positive
+from clpc.core.checks import check_bool, check_choice, check_int, check_positive
 from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError, IOData, as_iodata
 from clpc.model.structure import Structure
@@ -71,9 +72,15 @@ class CLPC:
         LPC options (see :class:`clpc.LPC`).
     mimo : {"siso", "paired", "miso"}, optional
         Multi-channel structure (default ``"siso"`` for 1x1 data, else ``"miso"``).
-    gate : bool
-        Accept an estimate only when the window determines it (default ``False``: every
-        computable estimate is accepted, as in the paper).
+    guard : bool
+        Accept an estimate only from a trusted window (default ``True``): one that holds
+        ``trust_rows`` lag vectors, whose channels vary by at least three quantization
+        steps, and whose solution the data determine (:func:`clpc.core.rules.is_trusted`).
+        ``False`` is the paper's appraiser: every computable estimate is accepted.
+    trust_rows : int, optional
+        Lag vectors a trusted window needs (default ``max(10 p, W / 2)``, at most ``W``).
+    gate : bool, optional
+        Former name of ``guard``.
     min_rows : int, optional
         Fewest rows for a usable estimate (default ``2 p``); smaller windows are not solved.
     data_sample_time : float, optional
@@ -107,7 +114,9 @@ class CLPC:
         noise_ratio: float | None = None,
         noise_cov: Any = None,
         rule: RobustRule | None = None,
-        gate: bool = False,
+        guard: bool = True,
+        trust_rows: int | None = None,
+        gate: bool | None = None,
         min_rows: int | None = None,
         data_sample_time: float | None = None,
         n_jobs: int = 1,
@@ -132,7 +141,8 @@ class CLPC:
         self.noise_ratio = noise_ratio
         self.noise_cov = None if noise_cov is None else np.asarray(noise_cov, dtype=float)
         self.rule = rule or RobustRule()
-        self.gate = bool(gate)
+        self.guard = check_bool(guard if gate is None else gate, "guard")
+        self.trust_rows = None if trust_rows is None else check_int(trust_rows, "trust_rows", 1)
         self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2)
         self.sample_time = None if sample_time is None else _seconds(sample_time, "sample_time")
         self.data_sample_time = (
@@ -162,6 +172,11 @@ class CLPC:
         self._setup: KernelSetup | None = None
         self._empty: Trace | None = None
         return self
+
+    @property
+    def gate(self) -> bool:
+        """Former name of :attr:`guard`."""
+        return self.guard
 
     @property
     def counter(self) -> int:

@@ -17,6 +17,7 @@ from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.engine import Engine, settings_for, window_plan
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup, TraceLabels, empty_arrays, solve_updates
+from clpc.core.rules import trust_rows
 from clpc.data import DataError
 from clpc.lpc.regressors import miso_regressor
 from clpc.model.structure import check_mode, default_mode
@@ -105,7 +106,14 @@ def kernel_setup(a: Any) -> KernelSetup:
             plan=plan,
             settings=settings_for((a.method, a.scaling), a.rule, cov, s.na, n_channels),
             fsm=kernel.FsmSettings(
-                min_rows(a), a.gate, a.rule.separation, s.na, s.nb, s.nk, not miso
+                min_rows(a),
+                a.guard,
+                trust_rows(n_params(a), a.window_size) if a.trust_rows is None else a.trust_rows,
+                a.rule.separation,
+                s.na,
+                s.nb,
+                s.nk,
+                not miso,
             ),
             n_inputs=a._n_in,
         )
@@ -124,7 +132,7 @@ def labels(a: Any) -> TraceLabels:
         mode=mode(a) if a._n_in is not None else "siso",
         sample_time=time_step(a),
         names=names,
-        meta={"gate": a.gate, "method": a.method},
+        meta={"guard": a.guard, "gate": a.guard, "method": a.method, "scaling": a.scaling},
     )
 
 
@@ -161,7 +169,7 @@ def consume(a: Any, new: np.ndarray) -> Trace:
         threads = (a.n_jobs, a._executor().map if a.n_jobs > 1 else map)
         parts = solve_updates(
             kernel_setup(a),
-            (buf.data, buf.start - s.max_lag),
+            ((buf.data, buf.resolution), buf.start - s.max_lag),
             (a._j_done + 1, j_last),
             state,
             threads,

@@ -42,6 +42,8 @@ from clpc.core.rules import (
     eig_ratio,
     index_j,
     is_determined,
+    is_excited,
+    is_trusted,
     likelihood_variance,
     solve_from_eig,
     solved_matrix,
@@ -79,6 +81,7 @@ class Solved(NamedTuple):
     n_null: np.ndarray
     n_input_relations: np.ndarray
     degenerate: np.ndarray
+    excited: np.ndarray
     n_rows: np.ndarray
 
 
@@ -86,7 +89,8 @@ class FsmSettings(NamedTuple):
     """The FSM output's settings."""
 
     min_rows: int
-    gate: bool
+    guard: bool  #: accept only trusted windows
+    trust_rows: int  #: rows a trusted window needs
     separation_tol: float
     na: int
     nb: int
@@ -110,6 +114,7 @@ class FsmOutput(NamedTuple):
     accepted: np.ndarray
     has_model: np.ndarray
     determined: np.ndarray
+    trusted: np.ndarray
     not_enough: np.ndarray
     den: np.ndarray
     num: np.ndarray
@@ -280,7 +285,7 @@ def solve_one(
 
 @kernel
 def solve_windows(
-    samples: np.ndarray,
+    data: tuple[np.ndarray, np.ndarray],
     first_row: int,
     windows: tuple[int, int],
     plan: WindowPlan,
@@ -289,10 +294,13 @@ def solve_windows(
 ) -> None:
     """Solve windows ``j0 .. j0 + count - 1`` (``windows = (j0, count)``) of every equation.
 
-    ``samples`` (n, channels): lag row ``r`` (absolute) has its newest sample at
-    ``samples[r - first_row]``. Windows with fewer than ``plan.min_rows`` rows are not
-    solved (their outputs are zero and flagged degenerate).
+    ``data = (samples, resolution)``, both (n, channels): lag row ``r`` (absolute) has its
+    newest sample at ``samples[r - first_row]``; ``resolution`` is each channel's smallest
+    nonzero change up to that sample (for :func:`clpc.core.rules.is_excited`). Windows
+    with fewer than ``plan.min_rows`` rows are not solved (their outputs are zero and
+    flagged degenerate).
     """
+    samples, resolution = data
     j0, count = windows
     n_eq, p = plan.chan.shape
     window, cluster = plan.window, plan.cluster
@@ -330,6 +338,7 @@ def solve_windows(
                 out.n_null[w, eq] = 0
                 out.n_input_relations[w, eq] = 0
                 out.degenerate[w, eq] = True
+                out.excited[w, eq] = False
                 continue
             full_lo = -(-start // cluster)
             t_size = full_lo * cluster - start  # the tail of the block holding start
@@ -353,6 +362,7 @@ def solve_windows(
             out.n_null[w, eq] = res[4]
             out.n_input_relations[w, eq] = res[5]
             out.degenerate[w, eq] = res[6]
+            out.excited[w, eq] = is_excited(scat, n_w, chan, resolution[first + e - 1])
 
 
 @kernel
@@ -386,7 +396,9 @@ def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput)
                 fs.separation_tol,
             )
             out.determined[w, e] = det
-            ok = accepts(few, solved.degenerate[w, e], solved.a0_weight[w, e], fs.gate, det)
+            trusted = is_trusted(n_rows, fs.trust_rows, solved.excited[w, e], det)
+            out.trusted[w, e] = trusted
+            ok = accepts(few, solved.degenerate[w, e], solved.a0_weight[w, e], fs.guard, trusted)
             out.accepted[w, e] = ok
             if ok:
                 for a in range(p):

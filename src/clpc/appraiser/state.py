@@ -46,7 +46,8 @@ def config_of(a: Any) -> dict[str, Any]:
         "noise_ratio": a.noise_ratio,
         "noise_cov": None if a.noise_cov is None else a.noise_cov.tolist(),
         "rule": asdict(a.rule),
-        "gate": a.gate,
+        "guard": a.guard,
+        "trust_rows": a.trust_rows,
         "min_rows": a.min_rows,
         "data_sample_time": a.data_sample_time,
         "n_jobs": a.n_jobs,
@@ -69,6 +70,9 @@ def snapshot(a: Any) -> dict[str, Any]:
         "n_out": a._n_out,
         "names": None if a._names is None else [list(n) for n in a._names],
         "buf": _arr(np.empty((0, 0)) if buf is None else buf.data),
+        "resolution": None if buf is None else _arr(buf.resolution),
+        "last_sample": None if buf is None or buf.last is None else _arr(buf.last),
+        "step": None if buf is None else _arr(buf.step),
         "buf_start": 0 if buf is None else buf.start,
         "n_seen": a._n_seen,
         "j_done": a._j_done,
@@ -88,6 +92,8 @@ def restore(cls: Any, state: dict[str, Any]) -> Any:
         raise ValueError("not a clpc appraiser state (format/version mismatch).")
     cfg = dict(state["config"])
     size = cfg.pop("parameters_size")
+    if "gate" in cfg:  # states written before the guard was renamed
+        cfg["guard"] = cfg.pop("gate")
     rule = RobustRule(**cfg.pop("rule"))
     a = cls(size, rule=rule, **cfg)
     a._n_in, a._n_out = state["n_in"], state["n_out"]
@@ -97,6 +103,10 @@ def restore(cls: Any, state: dict[str, Any]) -> Any:
         data = _unarr(state["buf"])
         if data is not None and data.size:
             a._buffer.data = data
+        for key, attr in (("resolution", "resolution"), ("last_sample", "last"), ("step", "step")):
+            value = _unarr(state.get(key))
+            if value is not None and value.size:
+                setattr(a._buffer, attr, value)
         a._buffer.start = int(state["buf_start"])
     a._n_seen = int(state["n_seen"])
     a._j_done = int(state["j_done"])

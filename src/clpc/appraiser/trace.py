@@ -27,6 +27,8 @@ SCALAR_KEYS = (
     "n_input_relations",
     "degenerate",
     "determined",
+    "excited",
+    "trusted",
     "accepted",
     "has_model",
     "stable",
@@ -57,6 +59,11 @@ class Convergence:
         After convergence: largest ``||theta_j - theta_ss||`` over accepted updates.
     D_variation : float
         After convergence: largest ``|D_j - mean D| / mean D``.
+    trusted_fraction : float
+        Share of the updates whose window is trusted (every equation); convergence is
+        never reported below :data:`MIN_TRUSTED_FRACTION`.
+    reason : str
+        In words: why the trace converged or did not.
     """
 
     converged: bool
@@ -68,6 +75,13 @@ class Convergence:
     consecutive: int
     theta_variation: float
     D_variation: float
+    trusted_fraction: float = 1.0
+    reason: str = ""
+
+
+#: ``converged`` is never reported when fewer updates than this share come from trusted
+#: windows (most windows then say nothing reliable about the system).
+MIN_TRUSTED_FRACTION = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -239,24 +253,33 @@ class Trace:
             quiet[1:] = acc[1:] & acc[:-1] & (dtheta < theta_tol) & (dd < D_tol)
         run = np.convolve(quiet.astype(int), np.ones(consecutive, dtype=int), "valid")
         hits = np.flatnonzero(run == consecutive) if run.size else np.array([], int)
-        if hits.size == 0:
-            return Convergence(
-                False,
-                -1,
-                -1,
-                float("nan"),
-                theta_tol,
-                D_tol,
-                consecutive,
-                float("nan"),
-                float("nan"),
+        trusted = self.arrays.get("trusted")
+        frac = float(trusted.all(axis=1).mean()) if trusted is not None and n else 1.0
+        none = (float("nan"), theta_tol, D_tol, consecutive, float("nan"), float("nan"))
+        if frac < MIN_TRUSTED_FRACTION:
+            why = (
+                f"not converged: only {frac:.0%} of the {n} windows are trusted (at least "
+                f"{MIN_TRUSTED_FRACTION:.0%} needed: enough rows, excited above quantization, "
+                "determined)"
             )
+            return Convergence(False, -1, -1, *none, frac, why)
+        if hits.size == 0:
+            why = (
+                f"not converged: no {consecutive} accepted updates in a row moved theta by "
+                f"less than {theta_tol:g} and D by less than {D_tol:.0%}"
+            )
+            return Convergence(False, -1, -1, *none, frac, why)
         start = int(hits[0])
         after = acc & (np.arange(n) >= start)
         ss = _mean_theta(theta[after])
         th_var = float(np.linalg.norm(theta[after] - ss[None], axis=2).max())
         d_mean = d[after].mean(axis=0)
         d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
+        why = (
+            f"converged at update {start + 1}: {consecutive} accepted updates in a row moved "
+            f"theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; {frac:.0%} of "
+            "the windows are trusted"
+        )
         return Convergence(
             True,
             start,
@@ -267,6 +290,8 @@ class Trace:
             consecutive,
             th_var,
             d_var,
+            frac,
+            why,
         )
 
     def steady_state_model(
@@ -296,8 +321,8 @@ class Trace:
         else:
             raise ValueError(
                 "the trace never became quasi-constant (no steady state): "
-                f"{int(acc.sum())} of {len(self)} updates were accepted. Use a longer record, "
-                "a richer input, larger tolerances, or allow_unconverged=True."
+                f"{int(acc.sum())} of {len(self)} updates were accepted; {conv.reason}. Use "
+                "a longer record, a richer input, larger tolerances, or allow_unconverged=True."
             )
         theta = _mean_theta(self.arrays["theta"][sel])
         c = self.arrays["c"][sel].mean(axis=0)

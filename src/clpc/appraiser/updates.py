@@ -86,9 +86,10 @@ def solve_updates(
     Parameters
     ----------
     setup : KernelSetup
-    samples : (buffer, first_row)
-        Buffered samples (n, channels) and the absolute lag row of ``buffer[0]`` minus
-        ``max_lag`` (see :func:`clpc.appraiser.kernel.solve_windows`).
+    samples : ((buffer, resolution), first_row)
+        Buffered samples (n, channels), each channel's running quantization step, and the
+        absolute lag row of ``buffer[0]`` minus ``max_lag`` (see
+        :func:`clpc.appraiser.kernel.solve_windows`).
     updates : (j_first, j_last)
     state : FsmState
         The carried FSM state, updated in place.
@@ -122,6 +123,7 @@ def solve_updates(
             n_null=sol.n_null,
             n_input_relations=sol.n_input_relations,
             degenerate=sol.degenerate,
+            excited=sol.excited,
             n_rows=sol.n_rows,
         )
         out.append((j0, count, arrays))
@@ -139,7 +141,7 @@ def empty_arrays(n_equations: int, p: int, structure: Structure, n_inputs: int) 
         "eigenvalues": (p,),
     }
     ints = ("n_null", "n_input_relations")
-    bools = ("degenerate", "determined", "accepted", "has_model", "stable")
+    bools = ("degenerate", "determined", "excited", "trusted", "accepted", "has_model", "stable")
     arrays: dict[str, np.ndarray] = {}
     for key in PER_EQUATION:
         dtype = np.int64 if key in ints else (np.bool_ if key in bools else np.float64)

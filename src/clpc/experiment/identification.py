@@ -12,6 +12,7 @@ from clpc.appraiser.trace import Convergence, Trace
 from clpc.experiment.results import Identification
 from clpc.experiment.settings import (
     CLUSTER_SIZE,
+    GUARD,
     LOG_SAMPLE_TIME,
     PARAMETERS_SIZE,
     SAMPLE_TIME,
@@ -39,7 +40,9 @@ def appraise(u: Any, y: Any, dt: float, method: str) -> Identification:
     :data:`TOLERANCES` that converges, else the last accepted update. ``u`` and ``y`` of the
     result are the signals given (not decimated).
     """
-    appraiser = CLPC(PARAMETERS_SIZE, WINDOW_SIZE, CLUSTER_SIZE, SAMPLE_TIME, method=method)
+    appraiser = CLPC(
+        PARAMETERS_SIZE, WINDOW_SIZE, CLUSTER_SIZE, SAMPLE_TIME, method=method, guard=GUARD
+    )
     u_arr, y_arr = np.asarray(u), np.asarray(y)
     trace = appraiser.run(u_arr, y_arr, dt=dt)
     conv, level = find_convergence(trace)

@@ -91,7 +91,7 @@ def setup_table(summary: dict[str, Any]) -> str:
 | window_size | 201 samples (2 s) | {s["window_size"]} samples ({s["window_time"]:.1f} s) |
 | data_cluster_dimension | 12 samples | {s["cluster_size"]} samples |
 | LPC solution | eigenvector of the smallest eigenvalue | `method="{s["method"]}"`, every \
-computable estimate accepted (`gate=False`) |
+computable estimate accepted (`guard=False`) |
 | command | ramp with saturation (Fig. 5) | ramp 0 -> {ramp["level"]} rad from \
 {ramp["start"]} s to {ramp["start"] + ramp["ramp_time"]:.1f} s, then held; \
 {ramp["duration"]:.1f} s record |

@@ -31,7 +31,7 @@ NOTES = """## Notes and workarounds
   signals (`clpc.experiment.decimate` reproduces the appraiser's filter exactly).
 - The actuator models are non-minimum-phase (a sampling zero); the torque is estimated with the
   stable non-causal inverse, not with `infer_input(allow_unstable=True)`, which diverges.
-- With `gate=False` the appraiser accepts estimates from windows where the command is constant
+- With `guard=False` the appraiser accepts estimates from windows where the command is constant
   (after a ramp has left the window), some with a0 nearly 0 (relations of the command alone):
   the held output, and a steady-state model built from it, are then meaningless. The ramp
   record therefore stops when the ramp leaves the window.

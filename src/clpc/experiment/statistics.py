@@ -88,6 +88,8 @@ def parameter_statistics(ident: Identification) -> dict[str, Any]:
         "consecutive": conv.consecutive if ident.level >= 0 else None,
         "accepted_fraction": float(np.mean(trace.accepted)),
         "determined_fraction": float(np.mean(trace.determined)),
+        "trusted_fraction": float(conv.trusted_fraction),
+        "convergence_reason": conv.reason,
         "accepted_without_a0": int(np.sum(trace.accepted & (trace.theta_estimate[:, 0] < A0_MIN))),
         "held_a0_min": float(a0[trace.has_model].min()) if trace.has_model.any() else None,
     }

@@ -128,7 +128,7 @@ def describe_trace(trace: Any) -> list[str]:
         parameters there are held"``.
     """
     arr = trace.arrays
-    held_note = " (the parameters there are held)" if trace.meta.get("gate") else ""
+    held_note = " (the parameters there are held)" if trace.meta.get("guard") else ""
     order = trace.structure.nb + 1
     out = []
     n = len(trace)
@@ -148,6 +148,15 @@ def describe_trace(trace: Any) -> list[str]:
     poorly &= ~trace.not_enough_data & ~(arr["n_input_relations"] > 0).any(axis=1)
     add(poorly, "the window does not determine the parameters")
     add(arr["has_model"].all(axis=1) & ~arr["stable"].all(axis=1), "the model is unstable")
+    if "excited" in arr:
+        add(
+            ~arr["excited"].all(axis=1) & ~arr["degenerate"].any(axis=1),
+            "a channel varies by fewer than 3 quantization steps",
+        )
     good = int((arr["determined"].all(axis=1)).sum())
     out.append(f"{good} of {n} clusters determine the parameters")
+    if "trusted" in arr:
+        trusted = int(arr["trusted"].all(axis=1).sum())
+        guard = "only these are accepted" if trace.meta.get("guard") else "the guard is off"
+        out.append(f"{trusted} of {n} clusters are trusted ({guard})")
     return out
