@@ -333,11 +333,11 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
     if noise is None and a.noise_ratio is not None:
         noise = np.concatenate([np.ones(na1), np.full(n_blocks * nb1, float(a.noise_ratio))])
     n_updates = mats.shape[1] // a.cluster_size
-    # each channel's running quantization step: the smallest nonzero change so far
+    # each channel's quantization step in a window: its smallest nonzero change between
+    # consecutive samples of the window (the newest sample of each row)
     samples = np.hstack([u2, y2])
     change = np.abs(np.diff(samples, axis=0, prepend=samples[:1]))
     change[~(change > 0)] = np.inf
-    step = np.minimum.accumulate(change, axis=0)
     col_chan = []
     for e in range(n_out):
         cols = [n_in + e] * na1
@@ -367,8 +367,9 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
             scaling=a.scaling,
         )
         std = np.sqrt(np.diagonal(scatter, axis1=1, axis2=2) / rows.shape[1])
-        newest = s.max_lag + end - 1
-        quanta = np.array([step[newest, col_chan[e]] for e in range(n_out)])
+        first_sample = s.max_lag + max(0, end - a.window_size)
+        window_step = change[first_sample : s.max_lag + end].min(axis=0)
+        quanta = np.array([window_step[col_chan[e]] for e in range(n_out)])
         excited.append(np.all(std >= 3.0 * quanta, axis=1))
         out["theta_estimate"].append(res.theta)
         out["eigenvalues"].append(res.eigenvalues)

@@ -120,34 +120,43 @@ class Engine:
         if name == "compiled":
             self._solve = compiled(kernel.solve_windows)
             self._output = compiled(kernel.fsm_output)
+            self._update = compiled(kernel.update_windows)
         else:
             self._solve = kernel.solve_windows
             self._output = kernel.fsm_output
+            self._update = kernel.update_windows
+
+    def update(
+        self, samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: Any, state: Any
+    ) -> tuple[kernel.Solved, kernel.FsmOutput]:
+        """Solve ``windows`` and run the FSM output over them in one kernel call.
+
+        ``setup`` is the record's :class:`clpc.appraiser.updates.KernelSetup` (its
+        ``plain`` settings go to :func:`clpc.appraiser.kernel.update_windows`), ``state``
+        the carried :class:`clpc.appraiser.kernel.FsmState` (updated in place).
+        """
+        solved = _solved(windows[1], setup.plan)
+        out = _fsm_output(solved, setup.fsm, setup.n_inputs)
+        self._update(
+            samples[0],
+            samples[1],
+            windows,
+            setup.plain,
+            tuple(state),
+            (tuple(solved), tuple(out)),
+        )
+        return solved, out
 
     def solve(
         self,
-        samples: tuple[np.ndarray, np.ndarray],
+        samples: np.ndarray,
         first_row: int,
         windows: tuple[int, int],
         plan: kernel.WindowPlan,
         settings: SolveSettings,
     ) -> kernel.Solved:
         """Solve ``windows = (j0, count)`` (see :func:`clpc.appraiser.kernel.solve_windows`)."""
-        count = windows[1]
-        e, p = plan.chan.shape
-        out = kernel.Solved(
-            theta=np.empty((count, e, p)),
-            eigenvalues=np.empty((count, e, p)),
-            c=np.empty((count, e)),
-            noise_variance=np.empty((count, e)),
-            separation=np.empty((count, e)),
-            a0_weight=np.empty((count, e)),
-            n_null=np.empty((count, e), dtype=np.int64),
-            n_input_relations=np.empty((count, e), dtype=np.int64),
-            degenerate=np.empty((count, e), dtype=np.bool_),
-            excited=np.empty((count, e), dtype=np.bool_),
-            n_rows=np.empty(count, dtype=np.int64),
-        )
+        out = _solved(windows[1], plan)
         self._solve(samples, first_row, windows, plan, settings, out)
         return out
 
@@ -155,30 +164,31 @@ class Engine:
         self, solved: kernel.Solved, fs: kernel.FsmSettings, state: kernel.FsmState, n_inputs: int
     ) -> kernel.FsmOutput:
         """The FSM output of ``solved`` (``state`` is updated in place)."""
-        count, e, p = solved.theta.shape
-
-        def f(*shape: int) -> np.ndarray:
-            return np.empty((count, *shape))
-
-        def b(*shape: int) -> np.ndarray:
-            return np.empty((count, *shape), dtype=np.bool_)
-
-        out = kernel.FsmOutput(
-            theta=f(e, p),
-            c=f(e),
-            accepted=b(e),
-            has_model=b(e),
-            determined=b(e),
-            trusted=b(e),
-            not_enough=b(),
-            den=f(e, fs.na + 1),
-            num=f(e, n_inputs, fs.nk + fs.nb + 1),
-            stable=b(e),
-            lambda_min=f(e),
-            lambda_max=f(e),
-            D=f(e),
-            eig_ratio=f(e),
-            J=f(e),
-        )
+        out = _fsm_output(solved, fs, n_inputs)
         self._output(solved, fs, state, out)
         return out
+
+
+def _solved(count: int, plan: kernel.WindowPlan) -> kernel.Solved:
+    e, p = plan.chan.shape
+    f = np.empty((2, count, e, p))  # same-shape fields share one allocation (hot path)
+    g = np.empty((4, count, e))
+    i = np.empty((2, count, e), np.int64)
+    b = np.empty((2, count, e), np.bool_)
+    return kernel.Solved(*f, *g, *i, *b, np.empty(count, np.int64))
+
+
+def _fsm_output(solved: kernel.Solved, fs: kernel.FsmSettings, n_inputs: int) -> kernel.FsmOutput:
+    count, e, p = solved.theta.shape
+    b = np.empty((5, count, e), np.bool_)
+    g = np.empty((5, count, e))
+    return kernel.FsmOutput(
+        np.empty((count, e, p)),
+        np.empty((count, e)),
+        *b[:4],
+        np.empty(count, np.bool_),
+        np.empty((count, e, fs.na + 1)),
+        np.empty((count, e, n_inputs, fs.nk + fs.nb + 1)),
+        b[4],
+        *g,
+    )

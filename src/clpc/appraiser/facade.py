@@ -41,7 +41,7 @@ from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.engine import resolve_engine
 from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
 from clpc.appraiser.trace import Trace
-from clpc.appraiser.updates import KernelSetup
+from clpc.appraiser.updates import KernelSetup, TraceLabels
 from clpc.core.checks import check_bool, check_choice, check_int, check_positive
 from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError, IOData, as_iodata
@@ -135,6 +135,7 @@ class CLPC:
         self.cluster_size = check_int(12 if cluster is None else cluster, "cluster_size", 1)
         order = self.parameters_size - 1
         self.structure = Structure(order if na is None else na, order if nb is None else nb, nk)
+        self._max_lag = self.structure.max_lag  # read on every step()
         self.method = check_choice(method, "method", ("robust", "paper"))
         self.scaling = check_choice(scaling, "scaling", SCALINGS)
         self.mimo = mimo
@@ -170,6 +171,7 @@ class CLPC:
         self._decimator: Decimator | None = None
         self._record_dt: float | None = None
         self._setup: KernelSetup | None = None
+        self._trace_labels: TraceLabels | None = None
         self._empty: Trace | None = None
         return self
 
@@ -219,7 +221,7 @@ class CLPC:
         u_k : float or array_like, shape (n_inputs,)
         y_k : float or array_like, shape (n_outputs,)
         """
-        rows_after = self._n_seen + 1 - self.structure.max_lag
+        rows_after = self._n_seen + 1 - self._max_lag
         update = rows_after > 0 and rows_after % self.cluster_size == 0
         plain = self._decimator is not None and self._decimator.factor == 1
         if plain and self._n_in == 1 and self._n_out == 1:

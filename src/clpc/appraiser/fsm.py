@@ -169,12 +169,14 @@ def consume(a: Any, new: np.ndarray) -> Trace:
         threads = (a.n_jobs, a._executor().map if a.n_jobs > 1 else map)
         parts = solve_updates(
             kernel_setup(a),
-            ((buf.data, buf.resolution), buf.start - s.max_lag),
+            (buf.data, buf.start - s.max_lag),
             (a._j_done + 1, j_last),
             state,
             threads,
         )
-        trace_labels = labels(a)
+        if a._trace_labels is None:
+            a._trace_labels = labels(a)
+        trace_labels = a._trace_labels
         traces = []
         for j0, count, arrays in parts:
             index = s.max_lag + c * np.arange(j0, j0 + count) - 1

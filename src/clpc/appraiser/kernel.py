@@ -194,6 +194,26 @@ def piece_stats(
 
 
 @kernel
+def piece_step(
+    samples: np.ndarray, chan: np.ndarray, first: int, rows: tuple[int, int], out: np.ndarray
+) -> None:
+    """Each column's smallest nonzero change over the newest samples of rows ``rows``.
+
+    The quantization step of a channel as far as the piece shows (``inf`` when it does not
+    change): row ``r``'s newest sample ``samples[first + r]`` against the one before it.
+    """
+    lo, hi = rows
+    for a in range(out.shape[0]):
+        best = math.inf
+        ch = chan[a]
+        for r in range(lo, hi):
+            d = abs(samples[first + r, ch] - samples[first + r - 1, ch])
+            if d > 0 and d < best:
+                best = d
+        out[a] = best
+
+
+@kernel
 def merge(
     blocks: tuple[np.ndarray, np.ndarray, int, int, int],
     tail: tuple[int, np.ndarray, np.ndarray],
@@ -285,7 +305,7 @@ def solve_one(
 
 @kernel
 def solve_windows(
-    data: tuple[np.ndarray, np.ndarray],
+    samples: np.ndarray,
     first_row: int,
     windows: tuple[int, int],
     plan: WindowPlan,
@@ -294,13 +314,12 @@ def solve_windows(
 ) -> None:
     """Solve windows ``j0 .. j0 + count - 1`` (``windows = (j0, count)``) of every equation.
 
-    ``data = (samples, resolution)``, both (n, channels): lag row ``r`` (absolute) has its
-    newest sample at ``samples[r - first_row]``; ``resolution`` is each channel's smallest
-    nonzero change up to that sample (for :func:`clpc.core.rules.is_excited`). Windows
-    with fewer than ``plan.min_rows`` rows are not solved (their outputs are zero and
-    flagged degenerate).
+    ``samples`` (n, channels): lag row ``r`` (absolute) has its newest sample at
+    ``samples[r - first_row]``. Windows with fewer than ``plan.min_rows`` rows are not
+    solved (their outputs are zero and flagged degenerate). A channel's quantization step
+    in a window (for :func:`clpc.core.rules.is_excited`) is its smallest nonzero change
+    between consecutive samples of the window.
     """
-    samples, resolution = data
     j0, count = windows
     n_eq, p = plan.chan.shape
     window, cluster = plan.window, plan.cluster
@@ -309,6 +328,9 @@ def solve_windows(
     n_blocks = j0 + count - 1 - b_lo  # block j - 1 is the newest of window j
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
+    b_step = np.empty((n_blocks, p))
+    t_step = np.empty(p)
+    step = np.empty(p)
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
     dev = np.empty((window // cluster + 2, p))
@@ -322,6 +344,7 @@ def solve_windows(
         for b in range(n_blocks):
             lo = (b_lo + b) * cluster
             piece_stats(samples, chan, lag, first, (lo, lo + cluster), z, (b_mean[b], b_scat[b]))
+            piece_step(samples, chan, first, (lo, lo + cluster), b_step[b])
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -346,6 +369,11 @@ def solve_windows(
                 piece_stats(
                     samples, chan, lag, first, (start, full_lo * cluster), z, (t_mean, t_scat)
                 )
+                piece_step(samples, chan, first, (start, full_lo * cluster), t_step)
+            for a in range(p):
+                step[a] = t_step[a] if t_size > 0 else math.inf
+                for b in range(full_lo - b_lo, j - b_lo):
+                    step[a] = min(step[a], b_step[b, a])
             n_w = merge(
                 (b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster),
                 (t_size, t_mean, t_scat),
@@ -362,7 +390,7 @@ def solve_windows(
             out.n_null[w, eq] = res[4]
             out.n_input_relations[w, eq] = res[5]
             out.degenerate[w, eq] = res[6]
-            out.excited[w, eq] = is_excited(scat, n_w, chan, resolution[first + e - 1])
+            out.excited[w, eq] = is_excited(scat, n_w, step)
 
 
 @kernel
@@ -423,3 +451,28 @@ def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput)
                     for k in range(out.num.shape[3]):
                         out.num[w, e, i, k] = 0.0
                 out.stable[w, e] = False
+
+
+@kernel
+def update_windows(
+    samples: np.ndarray,
+    first_row: int,
+    windows: tuple[int, int],
+    settings: tuple,  # type: ignore[type-arg]
+    state: tuple,  # type: ignore[type-arg]
+    out: tuple,  # type: ignore[type-arg]
+) -> None:
+    """:func:`solve_windows` then :func:`fsm_output` in one call (one dispatch per update).
+
+    The containers arrive as plain tuples - ``settings = (plan, solve settings, FSM
+    settings)``, ``state``, ``out = (solved, output)`` - in the fields' order of
+    :class:`WindowPlan`, :class:`SolveSettings`, :class:`FsmSettings`, :class:`FsmState`,
+    :class:`Solved` and :class:`FsmOutput`: numba types plain tuples of arrays several
+    times faster than named tuples at the call, which is most of the cost of one update.
+    """
+    plan = WindowPlan(*settings[0])
+    s = SolveSettings(*settings[1])
+    fs = FsmSettings(*settings[2])
+    solved = Solved(*out[0])
+    solve_windows(samples, first_row, windows, plan, s, solved)
+    fsm_output(solved, fs, FsmState(*state), FsmOutput(*out[1]))

@@ -70,9 +70,6 @@ def snapshot(a: Any) -> dict[str, Any]:
         "n_out": a._n_out,
         "names": None if a._names is None else [list(n) for n in a._names],
         "buf": _arr(np.empty((0, 0)) if buf is None else buf.data),
-        "resolution": None if buf is None else _arr(buf.resolution),
-        "last_sample": None if buf is None or buf.last is None else _arr(buf.last),
-        "step": None if buf is None else _arr(buf.step),
         "buf_start": 0 if buf is None else buf.start,
         "n_seen": a._n_seen,
         "j_done": a._j_done,
@@ -103,10 +100,6 @@ def restore(cls: Any, state: dict[str, Any]) -> Any:
         data = _unarr(state["buf"])
         if data is not None and data.size:
             a._buffer.data = data
-        for key, attr in (("resolution", "resolution"), ("last_sample", "last"), ("step", "step")):
-            value = _unarr(state.get(key))
-            if value is not None and value.size:
-                setattr(a._buffer, attr, value)
         a._buffer.start = int(state["buf_start"])
     a._n_seen = int(state["n_seen"])
     a._j_done = int(state["j_done"])

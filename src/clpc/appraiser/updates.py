@@ -33,6 +33,12 @@ class KernelSetup:
     settings: SolveSettings
     fsm: kernel.FsmSettings
     n_inputs: int
+    plain: tuple[tuple[Any, ...], ...] = ()  #: (plan, settings, fsm) as plain tuples
+
+    def __post_init__(self) -> None:
+        # what the kernel's entry point takes (fast to type at every call)
+        plain = (tuple(self.plan), tuple(self.settings), tuple(self.fsm))
+        object.__setattr__(self, "plain", plain)
 
 
 @dataclass(frozen=True)
@@ -86,10 +92,9 @@ def solve_updates(
     Parameters
     ----------
     setup : KernelSetup
-    samples : ((buffer, resolution), first_row)
-        Buffered samples (n, channels), each channel's running quantization step, and the
-        absolute lag row of ``buffer[0]`` minus ``max_lag`` (see
-        :func:`clpc.appraiser.kernel.solve_windows`).
+    samples : (buffer, first_row)
+        Buffered samples (n, channels) and the absolute lag row of ``buffer[0]`` minus
+        ``max_lag`` (see :func:`clpc.appraiser.kernel.solve_windows`).
     updates : (j_first, j_last)
     state : FsmState
         The carried FSM state, updated in place.
@@ -105,29 +110,49 @@ def solve_updates(
     buf, first_row = samples
     n_jobs, mapper = threads
     parts = batches(updates[0], updates[1], n_jobs)
+    if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
+        run = setup.engine.update
+        return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
 
     def solve(batch: tuple[int, int]) -> kernel.Solved:
         return setup.engine.solve(buf, first_row, batch, setup.plan, setup.settings)
 
-    solved = list(mapper(solve, parts)) if len(parts) > 1 else [solve(parts[0])]
-    out = []
-    for (j0, count), sol in zip(parts, solved, strict=True):
-        fsm = setup.engine.output(sol, setup.fsm, state, setup.n_inputs)._asdict()
-        arrays = {key: fsm[key] for key in fsm if key in PER_EQUATION or key == "not_enough"}
-        arrays.update(
-            theta_estimate=sol.theta,
-            eigenvalues=sol.eigenvalues,
-            separation=sol.separation,
-            a0_weight=sol.a0_weight,
-            noise_variance=sol.noise_variance,
-            n_null=sol.n_null,
-            n_input_relations=sol.n_input_relations,
-            degenerate=sol.degenerate,
-            excited=sol.excited,
-            n_rows=sol.n_rows,
-        )
-        out.append((j0, count, arrays))
-    return out
+    solved = list(mapper(solve, parts))  # windows are independent: threads
+    return [  # the FSM output runs in time order
+        (j0, count, _arrays(sol, setup.engine.output(sol, setup.fsm, state, setup.n_inputs)))
+        for (j0, count), sol in zip(parts, solved, strict=True)
+    ]
+
+
+def _arrays(sol: kernel.Solved, fsm: kernel.FsmOutput) -> dict[str, np.ndarray]:
+    """The per-update arrays of a trace part, from the kernel's two outputs."""
+    return {
+        "theta": fsm.theta,
+        "c": fsm.c,
+        "accepted": fsm.accepted,
+        "has_model": fsm.has_model,
+        "determined": fsm.determined,
+        "trusted": fsm.trusted,
+        "not_enough": fsm.not_enough,
+        "den": fsm.den,
+        "num": fsm.num,
+        "stable": fsm.stable,
+        "lambda_min": fsm.lambda_min,
+        "lambda_max": fsm.lambda_max,
+        "D": fsm.D,
+        "eig_ratio": fsm.eig_ratio,
+        "J": fsm.J,
+        "theta_estimate": sol.theta,
+        "eigenvalues": sol.eigenvalues,
+        "separation": sol.separation,
+        "a0_weight": sol.a0_weight,
+        "noise_variance": sol.noise_variance,
+        "n_null": sol.n_null,
+        "n_input_relations": sol.n_input_relations,
+        "degenerate": sol.degenerate,
+        "excited": sol.excited,
+        "n_rows": sol.n_rows,
+    }
 
 
 def empty_arrays(n_equations: int, p: int, structure: Structure, n_inputs: int) -> dict:

@@ -70,8 +70,9 @@ TRUST_ROWS_PER_PARAMETER = 10
 #: ... and at least this fraction of the full window (whichever is more, at most W).
 TRUST_WINDOW_FRACTION = 0.5
 #: A channel is excited in a window when its standard deviation there is at least this many
-#: quantization steps (the smallest nonzero change of the channel seen so far): below it a
-#: quantized signal takes a handful of values and satisfies exact spurious relations.
+#: quantization steps (the smallest nonzero change between consecutive samples of the
+#: window): below it a quantized signal takes a handful of values and satisfies exact
+#: spurious relations.
 EXCITATION_QUANTA = 3.0
 
 _EPS = 2.0**-52
@@ -519,16 +520,16 @@ def trust_rows(p: int, window: int) -> int:
 
 
 @kernel
-def is_excited(scat: np.ndarray, n_rows: float, chan: np.ndarray, resolution: np.ndarray) -> bool:
+def is_excited(scat: np.ndarray, n_rows: float, step: np.ndarray) -> bool:
     """Every lag column varies by at least :data:`EXCITATION_QUANTA` quantization steps.
 
-    ``chan[a]`` is the sample channel of column ``a``; ``resolution[ch]`` the smallest
-    nonzero change of channel ``ch`` seen so far (``inf`` before any).
+    ``step[a]`` is the quantization step of column ``a``'s channel in the window: its
+    smallest nonzero change between consecutive samples (``inf`` when it never changes).
     """
     n_safe = max(n_rows, 1.0)
     for a in range(scat.shape[0]):
         std = math.sqrt(max(scat[a, a], 0.0) / n_safe)
-        if not std >= EXCITATION_QUANTA * resolution[chan[a]]:
+        if not std >= EXCITATION_QUANTA * step[a]:
             return False
     return True
 
