@@ -175,14 +175,15 @@ def _solved(count: int, plan: kernel.WindowPlan) -> kernel.Solved:
     g = np.empty((4, count, e))
     i = np.empty((2, count, e), np.int64)
     b = np.empty((2, count, e), np.bool_)
-    return kernel.Solved(*f, *g, *i, *b, np.empty(count, np.int64))
+    fields = (*f, *g, *i, *b, np.empty(count, np.int64))
+    return kernel.Solved(*fields)
 
 
 def _fsm_output(solved: kernel.Solved, fs: kernel.FsmSettings, n_inputs: int) -> kernel.FsmOutput:
     count, e, p = solved.theta.shape
     b = np.empty((5, count, e), np.bool_)
     g = np.empty((5, count, e))
-    return kernel.FsmOutput(
+    fields = (
         np.empty((count, e, p)),
         np.empty((count, e)),
         *b[:4],
@@ -192,3 +193,4 @@ def _fsm_output(solved: kernel.Solved, fs: kernel.FsmSettings, n_inputs: int) ->
         b[4],
         *g,
     )
+    return kernel.FsmOutput(*fields)

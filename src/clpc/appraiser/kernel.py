@@ -28,7 +28,7 @@ digits.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -458,9 +458,9 @@ def update_windows(
     samples: np.ndarray,
     first_row: int,
     windows: tuple[int, int],
-    settings: tuple,  # type: ignore[type-arg]
-    state: tuple,  # type: ignore[type-arg]
-    out: tuple,  # type: ignore[type-arg]
+    settings: tuple[Any, ...],
+    state: tuple[Any, ...],
+    out: tuple[Any, ...],
 ) -> None:
     """:func:`solve_windows` then :func:`fsm_output` in one call (one dispatch per update).
 

@@ -10,14 +10,14 @@ pair closer than :data:`clpc.core.polynomials.CANCEL_DISTANCE` and refits the of
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from clpc.core.polynomials import CANCEL_DISTANCE, cancel_common_factors
 from clpc.data import IOData
 from clpc.lpc.regressors import regressors
-from clpc.model import LinearModel, ModelError, Structure
+from clpc.model import LinearModel, MimoMode, ModelError, Structure
 
 __all__ = ["reduce_model"]
 
@@ -61,7 +61,7 @@ def reduce_model(model: LinearModel, data: IOData, tol: float = CANCEL_DISTANCE)
     theta = np.array(
         [_theta(den, num, model.mode, j, s.nk) for j, (den, num, _) in enumerate(parts)]
     )
-    lag_rows = regressors(data, reduced, model.mode)  # (E, n, p)
+    lag_rows = regressors(data, reduced, cast(MimoMode, model.mode))  # (E, n, p)
     c = np.einsum("ep,ep->e", lag_rows.mean(axis=1), theta)  # eq. 24
     info["cancelled"] = m
     return replace(model, theta=theta, structure=reduced, c=c, info=info)
