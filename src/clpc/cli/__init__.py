@@ -1,5 +1,17 @@
-"""The ``clpc`` command line (click)."""
+"""The ``clpc`` command line (click): parsing and printing over :mod:`clpc.workflows`.
 
-from clpc.cli.commands import cli, main
+Commands: ``identify`` (batch LPC), ``track`` (the CLPC appraiser over a file, read in
+chunks), ``stream`` (the appraiser on standard input, one JSON line per update),
+``simulate``, ``compare``, ``datasets`` and ``demo``. Run ``clpc COMMAND --help``.
+
+Exit codes: 0 success, 1 a data or model error (one line on standard error, no traceback),
+2 a usage error (unknown option, bad option value); see :mod:`clpc.cli.errors`.
+
+Modules: ``app`` (the group, ``main``), ``errors``, ``options`` (shared options),
+``output`` (JSON and CSV printing), one module per command group: ``identify``, ``track``,
+``stream``, ``models`` (simulate, compare), ``info`` (datasets, demo).
+"""
+
+from clpc.cli.app import cli, main
 
 __all__ = ["cli", "main"]

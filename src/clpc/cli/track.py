@@ -1,0 +1,113 @@
+"""``clpc track``: the CLPC appraiser over a file, with a progress bar."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+
+import click
+
+from clpc.cli.errors import ClpcCommand
+from clpc.cli.options import (
+    appraiser_options,
+    appraiser_settings,
+    collect,
+    file_argument,
+    format_option,
+    input_option,
+    out_dir_option,
+    output_option,
+    record_settings,
+    sampling_options,
+    save_option,
+)
+from clpc.report import format_model_summary
+from clpc.workflows import (
+    Chunk,
+    ChunkFilter,
+    TrackResult,
+    TrackSettings,
+    count_data_lines,
+    track_file,
+)
+
+__all__ = ["track"]
+
+
+def _progress_bar(file: str) -> ChunkFilter:
+    """Chunks passed on under a progress bar on standard error (rows of ``file``)."""
+
+    def show(chunks: Iterator[Chunk]) -> Iterator[Chunk]:
+        length = count_data_lines(file) or 0
+        with click.progressbar(length=length, label="tracking", file=sys.stderr) as bar:
+            for names, values in chunks:
+                yield names, values
+                bar.update(values.shape[0])
+
+    return show
+
+
+def _print_result(result: TrackResult) -> None:
+    summary, conv = result.summary, result.summary["convergence"]
+    click.echo(
+        f"{summary['updates']} updates: {summary['accepted']} accepted, "
+        f"{summary['determined']} determined, {summary['not_enough_data']} with too few rows"
+    )
+    if summary["D_last"] is not None:
+        d_last = ", ".join(f"{d:.6g}" for d in summary["D_last"] if d is not None)
+        click.echo(f"D at the last update: {d_last}")
+    if conv["converged"]:
+        click.echo(
+            f"converged at update {conv['update']} (sample {conv['index']}, t = {conv['time']:g} s)"
+        )
+    else:
+        click.echo("did not converge (no quasi-constant phase)")
+    for line in summary["findings"]:
+        click.echo(f"  {line}")
+    if summary["model"] is not None:
+        click.echo(f"model ({result.model_source}):")
+        click.echo(format_model_summary(summary["model"]))
+    for f in result.files:
+        click.echo(f"wrote {f}")
+
+
+@click.command(cls=ClpcCommand)
+@file_argument()
+@input_option()
+@output_option()
+@out_dir_option("Folder for trace, figures and report (created).")
+@appraiser_options()
+@sampling_options()
+@format_option(["csv", "parquet"], "Format of the trace file.")
+@click.option(
+    "--chunk-rows",
+    type=click.IntRange(min=1),
+    default=100_000,
+    show_default=True,
+    help="Rows read from the file at a time.",
+)
+@click.option(
+    "--progress/--no-progress",
+    default=None,
+    help="Progress bar on standard error (default: only on a terminal).",
+)
+@save_option("Save the steady-state model.")
+@record_settings()
+@appraiser_settings()
+@collect("settings", TrackSettings)
+def track(settings: TrackSettings, progress: bool | None) -> None:
+    """Run the CLPC appraiser over a record (read in chunks) and write a trace and a report.
+
+    Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
+    OUT/trace.png, OUT/pz.png, OUT/bode.png and OUT/report.html.
+
+    \b
+    Examples:
+      clpc track servo.csv -u torque -y position --time t --out run1/
+      clpc track big.parquet -u u -y y --dt 0.001 --sample-time 0.01 --out run2/ --progress
+    """  # noqa: D301
+    show = progress if progress is not None else sys.stderr.isatty()
+    result = track_file(settings, _progress_bar(settings.record.file) if show else None)
+    if settings.save and result.model is None:
+        click.echo("no update was accepted: there is no model to save", err=True)
+    _print_result(result)

@@ -1,0 +1,254 @@
+"""Settings shared by several workflows: a record's columns, the appraiser's constructor."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+from clpc.appraiser import CLPC
+from clpc.core.checks import check_bool, check_choice, check_int, check_positive
+from clpc.data import IOData
+from clpc.io import load_iodata
+from clpc.model import LinearModel
+
+__all__ = [
+    "AppraiserSettings",
+    "ChannelCountError",
+    "Method",
+    "RecordSpec",
+    "SamplingConflictError",
+    "SettingsError",
+    "column_key",
+    "column_keys",
+    "model_columns",
+]
+
+#: the LPC solutions (see :class:`clpc.LPC`)
+Method = Literal["robust", "paper"]
+METHODS: tuple[Method, ...] = ("robust", "paper")
+
+
+class SettingsError(ValueError):
+    """Settings that contradict each other or the model (the command line's usage error)."""
+
+
+class SamplingConflictError(SettingsError):
+    """Both a sample time and a time column were given for one record."""
+
+    def __init__(self) -> None:
+        super().__init__("give either dt or time_col, not both.")
+
+
+class ChannelCountError(SettingsError):
+    """The number of columns given for a model's inputs or outputs is not the model's."""
+
+    def __init__(self, kind: str, model_names: list[str], given: list[str]) -> None:
+        self.kind, self.model_names, self.given = kind, model_names, given
+        super().__init__(
+            f"the model has {len(model_names)} {kind}(s) {model_names}; {len(given)} {kind} "
+            f"column(s) were given: {given}."
+        )
+
+
+def column_keys(columns: Sequence[str]) -> list[str | int]:
+    """Column keys: names, or 0-based indices when written as plain digits.
+
+    Parameters
+    ----------
+    columns : sequence of str
+        Column names as typed, e.g. ``["u", "2"]``.
+
+    Returns
+    -------
+    list of str or int
+        ``["u", 2]``: digit strings become indices.
+    """
+    return [int(c) if c.isdigit() else c for c in columns]
+
+
+def column_key(column: str | None) -> str | int | None:
+    """One column key (see :func:`column_keys`); ``None`` stays ``None``.
+
+    Parameters
+    ----------
+    column : str or None
+        A column name or digit string.
+
+    Returns
+    -------
+    str, int or None
+        The key.
+    """
+    return None if column is None else column_keys([column])[0]
+
+
+def _optional_positive(value: float | None, name: str) -> float | None:
+    return None if value is None else check_positive(value, name, "s")
+
+
+@dataclass(frozen=True)
+class RecordSpec:
+    """Where a record lives and which of its columns are the inputs, outputs and time.
+
+    Parameters
+    ----------
+    file : str
+        Data file (csv, tsv, parquet, npy, npz; see :func:`clpc.io.read_table`).
+    inputs, outputs : tuple of str
+        Column names, or 0-based indices written as digits. Empty where a model supplies
+        the names (:func:`clpc.workflows.compare_file`).
+    dt : float, optional
+        Sample time [s].
+    time_col : str, optional
+        Column of sample times [s] (uniformly spaced).
+    """
+
+    file: str
+    inputs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    dt: float | None = None
+    time_col: str | None = None
+
+    def __post_init__(self) -> None:
+        _optional_positive(self.dt, "dt")
+
+    def check_sampling(self) -> None:
+        """Refuse a record given both ``dt`` and ``time_col``.
+
+        Raises
+        ------
+        SamplingConflictError
+            Both are given.
+        """
+        if self.dt is not None and self.time_col is not None:
+            raise SamplingConflictError
+
+    def columns(self) -> list[str | int]:
+        """Keys of the input, output and (if any) time columns, in this order.
+
+        Returns
+        -------
+        list of str or int
+            Column keys (see :func:`column_keys`).
+        """
+        return column_keys(
+            [*self.inputs, *self.outputs, *([self.time_col] if self.time_col else [])]
+        )
+
+    def load(self) -> IOData:
+        """Read the record (see :func:`clpc.io.load_iodata`).
+
+        Returns
+        -------
+        IOData
+            The input/output record.
+
+        Raises
+        ------
+        SamplingConflictError
+            Both ``dt`` and ``time_col`` are given.
+        """
+        self.check_sampling()
+        return load_iodata(
+            self.file,
+            column_keys(self.inputs),
+            column_keys(self.outputs),
+            dt=self.dt,
+            time_column=column_key(self.time_col),
+        )
+
+
+@dataclass(frozen=True)
+class AppraiserSettings:
+    """The constructor arguments of :class:`clpc.CLPC` that the workflows expose.
+
+    Parameters
+    ----------
+    parameters_size : int
+        Size of ``a`` and of ``b`` (N + 1), at least 2.
+    window : int
+        Lag vectors per LPC window, at least 2.
+    cluster : int
+        Lag vectors between updates, at least 1.
+    nk : int
+        Input delay in samples.
+    sample_time : float, optional
+        Sample time [s] the appraiser works at (an integer multiple of the data's).
+    method : {"robust", "paper"}
+        LPC solution.
+    guard : bool
+        Accept estimates only from trusted windows (the default; ``False`` is the paper's
+        appraiser, see :class:`clpc.CLPC`).
+    """
+
+    parameters_size: int = 3
+    window: int = 201
+    cluster: int = 12
+    nk: int = 0
+    sample_time: float | None = None
+    method: Method = "robust"
+    guard: bool = True
+
+    def __post_init__(self) -> None:
+        check_int(self.parameters_size, "parameters_size", 2)
+        check_int(self.window, "window", 2)
+        check_int(self.cluster, "cluster", 1)
+        check_int(self.nk, "nk", 0)
+        _optional_positive(self.sample_time, "sample_time")
+        check_choice(self.method, "method", METHODS)
+        check_bool(self.guard, "guard")
+
+    def build(self, data_dt: float | None) -> CLPC:
+        """A new appraiser for data sampled every ``data_dt`` seconds.
+
+        Parameters
+        ----------
+        data_dt : float, optional
+            The data's sample time [s]; ``None`` means 1 (per sample).
+
+        Returns
+        -------
+        CLPC
+            The appraiser, working at ``sample_time`` (default: ``data_dt``).
+        """
+        return CLPC(
+            self.parameters_size,
+            self.window,
+            self.cluster,
+            self.sample_time or data_dt,
+            nk=self.nk,
+            data_sample_time=data_dt,
+            method=self.method,
+            guard=self.guard,
+        )
+
+
+def model_columns(model: LinearModel, given: Sequence[str], kind: str) -> list[str]:
+    """The columns of a model's inputs (``kind="input"``) or outputs.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model; its channel names are the default.
+    given : sequence of str
+        Columns named by the user, in the model's order; empty for the default.
+    kind : {"input", "output"}
+        Which channels.
+
+    Returns
+    -------
+    list of str
+        ``given``, or the model's names.
+
+    Raises
+    ------
+    ChannelCountError
+        ``given`` is not empty and its length is not the model's channel count.
+    """
+    names = list(model.input_names if kind == "input" else model.output_names)
+    if not given:
+        return names
+    if len(given) != len(names):
+        raise ChannelCountError(kind, names, list(given))
+    return list(given)

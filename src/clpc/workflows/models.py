@@ -1,0 +1,175 @@
+"""Saved models on files: simulate one, compare one with measured data."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from clpc.core.checks import check_int
+from clpc.core.jsonable import jsonable
+from clpc.io import load_model, read_table, write_table
+from clpc.report import model_response
+from clpc.workflows.common import RecordSpec, column_keys, model_columns
+
+__all__ = ["CompareResult", "CompareSettings", "SimulateResult", "compare_file", "simulate_file"]
+
+
+# =============================================================================== simulate
+@dataclass(frozen=True)
+class SimulateResult:
+    """The outcome of :func:`simulate_file`.
+
+    Attributes
+    ----------
+    names : list of str
+        Column names: the inputs, then ``OUTPUT_sim`` per model output.
+    values : ndarray, shape (n_rows, len(names))
+        The inputs and the simulated outputs.
+    out : str or None
+        The file written, if any.
+    """
+
+    names: list[str]
+    values: np.ndarray
+    out: str | None
+
+
+def simulate_file(
+    model_file: str, file: str, inputs: tuple[str, ...] = (), out: str | None = None
+) -> SimulateResult:
+    """Simulate a saved model on the input columns of a file (free run, zero initial state).
+
+    Parameters
+    ----------
+    model_file : str
+        A model saved by :func:`clpc.io.save_model`.
+    file : str
+        Data file with the input columns.
+    inputs : tuple of str
+        Input columns in the model's input order (default: the model's input names).
+    out : str, optional
+        Also write the result to this file (csv, tsv, parquet, npy, npz).
+
+    Returns
+    -------
+    SimulateResult
+        Column names and values.
+
+    Raises
+    ------
+    ChannelCountError
+        ``inputs`` does not name one column per model input.
+    """
+    model = load_model(model_file)
+    cols = model_columns(model, inputs, "input")
+    table = read_table(file, columns=column_keys(cols))
+    y_sim = np.asarray(model.simulate(table.data)).reshape(table.n_rows, -1)
+    names = [*table.names, *(f"{n}_sim" for n in model.output_names)]
+    values = np.hstack([table.data, y_sim])
+    if out:
+        write_table(out, names, values)
+    return SimulateResult(names, values, out)
+
+
+# =============================================================================== compare
+@dataclass(frozen=True)
+class CompareSettings:
+    """What :func:`compare_file` compares.
+
+    Parameters
+    ----------
+    model_file : str
+        A model saved by :func:`clpc.io.save_model`.
+    record : RecordSpec
+        Measured data; empty ``inputs``/``outputs`` mean the model's channel names.
+    k : int, optional
+        Compare ``k``-step-ahead predictions (default: free-run simulation).
+    plot : str, optional
+        Also plot measured against model output to this PNG file (needs matplotlib).
+    """
+
+    model_file: str
+    record: RecordSpec
+    k: int | None = None
+    plot: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.k is not None:
+            check_int(self.k, "k", 1)
+
+
+@dataclass(frozen=True)
+class CompareResult:
+    """The outcome of :func:`compare_file`.
+
+    Attributes
+    ----------
+    file : str
+        The measured record.
+    compared : str
+        ``"simulation"`` or ``"K-step prediction"``.
+    first_sample : int
+        First sample of the fit (the ones before give the initial conditions).
+    n_samples : int
+        Samples in the record.
+    fit : dict of str to float or None
+        Fit % per output (``None``: the response diverges).
+    plot : str or None
+        The figure written, if any.
+    """
+
+    file: str
+    compared: str
+    first_sample: int
+    n_samples: int
+    fit: dict[str, float | None]
+    plot: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as JSON-safe fields (``plot`` only when a figure was written).
+
+        Returns
+        -------
+        dict
+            ``file``, ``compared``, ``first_sample``, ``n_samples``, ``fit`` [, ``plot``].
+        """
+        fields = dataclasses.asdict(self)
+        if self.plot is None:
+            del fields["plot"]
+        return fields
+
+
+def compare_file(settings: CompareSettings) -> CompareResult:
+    """Compare a saved model with measured data: fit % of simulation or k-step prediction.
+
+    Parameters
+    ----------
+    settings : CompareSettings
+        Model file, record, horizon, optional figure.
+
+    Returns
+    -------
+    CompareResult
+        Fit % per output (100 = perfect, 0 = as good as the mean).
+
+    Raises
+    ------
+    ChannelCountError
+        The record's columns do not match the model's channels in number.
+    """
+    model = load_model(settings.model_file)
+    ins = model_columns(model, settings.record.inputs, "input")
+    outs = model_columns(model, settings.record.outputs, "output")
+    record = dataclasses.replace(settings.record, inputs=tuple(ins), outputs=tuple(outs))
+    data = record.load()
+    y_hat, start, fit = model_response(model, data.u, data.y, settings.k)
+    what = "simulation" if settings.k is None else f"{settings.k}-step prediction"
+    fits = dict(zip(outs, jsonable(fit), strict=True))
+    if settings.plot:
+        from clpc.plotting import plot_compare
+
+        plot_compare(data.time, data.y, y_hat, fit, settings.plot, names=outs, label=what)
+    return CompareResult(record.file, what, start, data.n_samples, fits, settings.plot or None)

@@ -1,0 +1,251 @@
+"""The appraiser over a record read in chunks: a trace file, figures and a report."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from clpc.appraiser import CLPC
+from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
+from clpc.core.checks import check_choice, check_int
+from clpc.data import DataError
+from clpc.io import iter_table_chunks, save_model
+from clpc.model import LinearModel
+from clpc.report import steady_state, trace_summary, write_track_report
+from clpc.workflows.common import AppraiserSettings, RecordSpec
+
+__all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
+
+#: column names and values of a block of rows (see :func:`clpc.io.iter_table_chunks`)
+Chunk = tuple[list[str], np.ndarray]
+#: wraps the chunks as they are read, e.g. to show progress
+ChunkFilter = Callable[[Iterator[Chunk]], Iterator[Chunk]]
+
+TraceFormat = Literal["csv", "parquet"]
+_TEXT_SUFFIXES = (".csv", ".tsv", ".tab", ".txt", ".dat")
+
+
+@dataclass(frozen=True)
+class TrackSettings:
+    """What :func:`track_file` runs, and where it writes.
+
+    Parameters
+    ----------
+    record : RecordSpec
+        The record and its input/output (and time) columns.
+    out_dir : str
+        Folder for trace, figures and report (created).
+    appraiser : AppraiserSettings
+        The appraiser's settings.
+    fmt : {"csv", "parquet"}
+        Format of the trace file ``OUT/trace.FMT``.
+    chunk_rows : int
+        Rows read from the file at a time.
+    save : str, optional
+        Save the steady-state model to this JSON file.
+    """
+
+    record: RecordSpec
+    out_dir: str
+    appraiser: AppraiserSettings = field(default_factory=AppraiserSettings)
+    fmt: TraceFormat = "csv"
+    chunk_rows: int = 100_000
+    save: str | None = None
+
+    def __post_init__(self) -> None:
+        check_choice(self.fmt, "fmt", ("csv", "parquet"))
+        check_int(self.chunk_rows, "chunk_rows", 1)
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """The outcome of :func:`track_file`.
+
+    Attributes
+    ----------
+    summary : dict
+        :func:`clpc.report.trace_summary` of the (thinned) trace.
+    model : LinearModel or None
+        The steady-state model (``None``: no update was accepted).
+    model_source : str
+        Where ``model`` comes from (see :func:`clpc.report.steady_state`).
+    files : list of Path
+        Files written: trace, figures, report and the saved model.
+    """
+
+    summary: dict[str, Any]
+    model: LinearModel | None
+    model_source: str
+    files: list[Path]
+
+
+def count_data_lines(path: str) -> int | None:
+    """Data lines of an uncompressed text file (one header line assumed), else ``None``.
+
+    Parameters
+    ----------
+    path : str
+        A data file; only csv, tsv, tab, txt and dat files are counted.
+
+    Returns
+    -------
+    int or None
+        At least 1 for a text file; ``None`` for other formats.
+    """
+    p = Path(path)
+    if p.suffix.lower() not in _TEXT_SUFFIXES:
+        return None
+    lines = 0
+    with p.open("rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            lines += block.count(b"\n")
+    return max(lines - 1, 1)
+
+
+class _Clock:
+    """Sample time from a time column read in chunks (uniform within ``rtol``)."""
+
+    def __init__(self, name: str, rtol: float = 1e-6) -> None:
+        self.name, self.rtol = name, rtol
+        self.last: float | None = None
+        self.dt: float | None = None
+        self.seen = 0
+
+    def feed(self, t: np.ndarray) -> None:
+        if t.size == 0:
+            return
+        full = t if self.last is None else np.concatenate([[self.last], t])
+        offset = self.seen - (0 if self.last is None else 1)
+        steps = np.diff(full)
+        if self.dt is None and steps.size:
+            self.dt = float(np.median(steps))
+        if self.dt is not None and steps.size:
+            bad = np.flatnonzero(~(np.abs(steps - self.dt) <= self.rtol * abs(self.dt)))
+            if bad.size or self.dt <= 0:
+                k = int(bad[0]) if bad.size else 0
+                raise DataError(
+                    f"time column {self.name!r} is not uniformly increasing at data row "
+                    f"{offset + k + 2} ({full[k]:.12g} -> {full[k + 1]:.12g}; expected a step "
+                    f"of {self.dt:.12g} s); resample the record onto a uniform grid or use --dt."
+                )
+        self.last = float(t[-1])
+        self.seen += t.size
+
+
+@dataclass
+class _Run:
+    """The state of one pass over the record."""
+
+    appraiser: CLPC
+    kept: ThinnedTrace
+    n_raw: int
+
+
+def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
+    """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``."""
+    record = settings.record
+    n_in, n_out = len(record.inputs), len(record.outputs)
+    clock = _Clock(record.time_col) if record.time_col else None
+    run: _Run | None = None
+    with TraceWriter(trace_file) as writer:
+        for names, values in _chunks(record, settings.chunk_rows, progress):
+            if clock is not None:
+                clock.feed(values[:, n_in + n_out])
+                if run is None and clock.dt is None:
+                    raise DataError(
+                        f"time column {record.time_col!r}: the first chunk has one sample; "
+                        "use a larger --chunk-rows or --dt."
+                    )
+            if run is None:
+                data_dt = clock.dt if clock is not None else record.dt
+                run = _Run(settings.appraiser.build(data_dt), ThinnedTrace(), 0)
+            run.n_raw += values.shape[0]
+            part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
+            if len(part):
+                part = dataclasses.replace(
+                    part,
+                    input_names=tuple(names[:n_in]),
+                    output_names=tuple(names[n_in : n_in + n_out]),
+                )
+                writer.write(part)
+                run.kept.add(part)
+    assert run is not None  # iter_table_chunks raises on a file without rows
+    return run
+
+
+def _chunks(record: RecordSpec, chunk_rows: int, progress: ChunkFilter | None) -> Iterator[Chunk]:
+    chunks = iter_table_chunks(record.file, chunk_rows, columns=record.columns())
+    return chunks if progress is None else progress(chunks)
+
+
+def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> None:
+    needed = settings.appraiser.window + run.appraiser.structure.max_lag
+    if run.appraiser.n_samples < needed or not run.kept.seen:
+        trace_file.unlink(missing_ok=True)
+        raise DataError(
+            f"the record is too short for the window: {run.appraiser.n_samples} sample(s) "
+            f"(of {run.n_raw} read) but --window {settings.appraiser.window} with "
+            f"--parameters-size {settings.appraiser.parameters_size} needs at least {needed}; "
+            "use a smaller --window or a longer record."
+        )
+
+
+def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
+    """Run the CLPC appraiser over a record (read in chunks); write a trace and a report.
+
+    Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
+    (see :func:`clpc.report.write_track_report`), and the steady-state model if asked.
+    Memory stays bounded whatever the record's length: the figures and the summary use
+    a thinned trace when there are many updates.
+
+    Parameters
+    ----------
+    settings : TrackSettings
+        Record, appraiser, output folder and formats.
+    progress : callable, optional
+        Wraps the iterator of chunks ``(names, values)`` read from the file (once the file
+        is open) and yields them on, e.g. to show a progress bar.
+
+    Returns
+    -------
+    TrackResult
+        Summary, steady-state model and the files written.
+
+    Raises
+    ------
+    SamplingConflictError
+        The record has both ``dt`` and ``time_col``.
+    clpc.DataError
+        Unreadable record; a time column that is not uniform; too few samples.
+    """
+    settings.record.check_sampling()
+    out = Path(settings.out_dir)
+    trace_file = out / f"trace.{settings.fmt}"
+    run = _appraise(settings, trace_file, progress)
+    _check_long_enough(run, settings, trace_file)
+    trace = run.kept.trace()
+    file = settings.record.file
+    report_settings = {
+        "file": file,
+        "samples (after decimation)": run.appraiser.n_samples,
+        "updates": run.kept.seen,
+        "updates in figures and summary": f"every {run.kept.stride}"
+        if run.kept.stride > 1
+        else "all",
+        **run.appraiser.config(),
+    }
+    summary = trace_summary(trace)
+    report = write_track_report(
+        out, trace, title=f"CLPC report: {file}", settings=report_settings, summary=summary
+    )
+    files = [trace_file, *report]
+    model, source = steady_state(trace)
+    if settings.save and model is not None:
+        save_model(model, settings.save)
+        files.append(Path(settings.save))
+    return TrackResult(summary, model, source, files)
