@@ -74,7 +74,7 @@ class CLPC:
         Multi-channel structure (default ``"siso"`` for 1x1 data, else ``"miso"``).
     guard : bool
         Accept an estimate only from a trusted window (default ``True``): one that holds
-        ``trust_rows`` lag vectors, whose channels vary by at least three quantization
+        ``trust_rows`` lag vectors, whose output varies by at least three quantization
         steps, and whose solution the data determine (:func:`clpc.core.rules.is_trusted`).
         ``False`` is the paper's appraiser: every computable estimate is accepted.
     trust_rows : int, optional

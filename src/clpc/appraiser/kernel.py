@@ -390,7 +390,7 @@ def solve_windows(
             out.n_null[w, eq] = res[4]
             out.n_input_relations[w, eq] = res[5]
             out.degenerate[w, eq] = res[6]
-            out.excited[w, eq] = is_excited(scat, n_w, step)
+            out.excited[w, eq] = is_excited(scat, n_w, step, s.n_out_cols)
 
 
 @kernel

@@ -9,12 +9,14 @@ and cached on disk. No rule exists twice; the engines differ only in who runs th
 
 numba caches a compiled function by its own source file only; a twin also depends on the
 files of the functions it calls. The cache stamp of every marked function is therefore
-the digest of all files that hold marked functions, so editing a rule invalidates every
-kernel that inlines it.
+the digest of every file of the package that marks functions (found by reading the
+package, not by what happens to be imported), so editing a rule invalidates every kernel
+that inlines it and nothing else does.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import types
@@ -28,7 +30,6 @@ __all__ = ["compiled", "kernel", "numba_available"]
 
 _MARKED: dict[int, Callable[..., Any]] = {}
 _TWINS: dict[int, Any] = {}
-_FILES: set[str] = set()
 
 
 def numba_available() -> bool:
@@ -39,7 +40,6 @@ def numba_available() -> bool:
 def kernel(fn: F) -> F:
     """Mark ``fn`` as part of the compiled engine; the plain function is returned unchanged."""
     _MARKED[id(fn)] = fn
-    _FILES.add(fn.__code__.co_filename)
     return fn
 
 
@@ -77,12 +77,28 @@ def compiled(fn: Callable[..., Any]) -> Any:
     return dispatcher
 
 
+_DIGEST: list[str] = []
+
+
+@functools.cache
+def _engine_files() -> frozenset[Path]:
+    """Every source file of the package that marks functions with :func:`kernel`."""
+    root = Path(__file__).resolve().parent.parent
+    return frozenset(
+        path
+        for path in root.rglob("*.py")
+        if path.name != "jit.py" and "@kernel" in path.read_text(encoding="utf-8")
+    )
+
+
 def _engine_digest() -> str:
-    digest = hashlib.sha256()
-    for path in sorted(_FILES):
-        digest.update(path.encode())
-        digest.update(Path(path).read_bytes())
-    return digest.hexdigest()
+    if not _DIGEST:
+        digest = hashlib.sha256()
+        for path in sorted(_engine_files()):
+            digest.update(path.name.encode())
+            digest.update(path.read_bytes())
+        _DIGEST.append(digest.hexdigest())
+    return _DIGEST[0]
 
 
 _STAMP_INSTALLED = False
@@ -104,7 +120,7 @@ def _install_stamp() -> None:
         return  # numba's own stamp (the function's file) still works, only less strictly
 
     def stamp(self: Any) -> Any:
-        if self._py_file in _FILES:
+        if Path(self._py_file).resolve() in _engine_files():
             return _engine_digest()
         return super(type(self), self).get_source_stamp()
 

@@ -69,8 +69,8 @@ ROUNDING_VARIANCE_FACTOR = 1e3
 TRUST_ROWS_PER_PARAMETER = 10
 #: ... and at least this fraction of the full window (whichever is more, at most W).
 TRUST_WINDOW_FRACTION = 0.5
-#: A channel is excited in a window when its standard deviation there is at least this many
-#: quantization steps (the smallest nonzero change between consecutive samples of the
+#: The output is excited in a window when its standard deviation there is at least this
+#: many quantization steps (its smallest nonzero change between consecutive samples of the
 #: window): below it a quantized signal takes a handful of values and satisfies exact
 #: spurious relations.
 EXCITATION_QUANTA = 3.0
@@ -520,14 +520,18 @@ def trust_rows(p: int, window: int) -> int:
 
 
 @kernel
-def is_excited(scat: np.ndarray, n_rows: float, step: np.ndarray) -> bool:
-    """Every lag column varies by at least :data:`EXCITATION_QUANTA` quantization steps.
+def is_excited(scat: np.ndarray, n_rows: float, step: np.ndarray, n_out_cols: int) -> bool:
+    """The output varies by at least :data:`EXCITATION_QUANTA` quantization steps.
 
     ``step[a]`` is the quantization step of column ``a``'s channel in the window: its
     smallest nonzero change between consecutive samples (``inf`` when it never changes).
+    Only the output columns (the first ``n_out_cols``) are checked: the output is the
+    measured, quantized signal (a resolver or encoder at rest jitters by a step or two),
+    while an input is often a command with few levels on purpose (a PRBS changes by its
+    whole amplitude, and is exciting).
     """
     n_safe = max(n_rows, 1.0)
-    for a in range(scat.shape[0]):
+    for a in range(n_out_cols):
         std = math.sqrt(max(scat[a, a], 0.0) / n_safe)
         if not std >= EXCITATION_QUANTA * step[a]:
             return False
