@@ -5,16 +5,16 @@ system ``A(q) y = B(q) u + e`` with ``A = 1 - 1.5 q^-1 + 0.7 q^-2``, ``B = 0.5 +
 0.1 q^-2`` and equation noise ``e ~ N(0, 0.1^2)``, plus white measurement noise (std 0.02) on
 ``y``. Settings: ``N = 2`` (``parameters_size = 3``), ``W = 201``, ``C = 12``.
 
-Engines (``CLPC(engine=...)``): ``compiled`` is the numba kernel of
-:mod:`clpc.appraiser.kernel` (the default, ``engine="auto"``, when numba is installed);
-``numpy`` is the vectorised numpy/LAPACK engine. Every ``clpc`` row of the tables names the
-engine it used; the references have none (``-``). Measured with both engines: batch at every
-``T``, ``push(10000)``, ``step``, ``cluster_size=1`` and the exactness checks; with the
-compiled engine only: ``push(100)``, ``push(1)``, ``method='paper'`` vs ``'robust'`` and
-``n_jobs=2`` vs 1 (without numba everything runs on the numpy engine). The compiled engine
-compiles on its first use in a fresh environment (~13 s, then cached on disk by numba); the
-script triggers that once at start-up (the time is printed) and every measurement warms up
-its engine before timing, so compilation is never timed.
+Engines (``CLPC(engine=...)``): every rule has one source (:mod:`clpc.core.rules`, kernel
+:mod:`clpc.appraiser.kernel`), run compiled by numba (``compiled``, the default through
+``engine="auto"``) or uncompiled (``python``, for debugging; ~100x slower). Everything is
+measured with ``compiled``; ``python`` gets one batch row at ``T <= --python-max`` (default
+1e4, one repetition) and an exactness check against ``compiled`` on 5e3 samples. The
+compiled kernels are built on their first use in an environment (numba caches them on disk
+under ``src/clpc/**/__pycache__``); the script loads them once at start-up, in this process
+and in a fresh one per package (the time is printed), and every measurement warms up
+before timing, so compilation is never timed. Only the public API is used (``clpc.CLPC``,
+``run``, ``push``, ``step``, ``clpc.Trace``).
 
 Paths timed on the same data:
 
@@ -22,18 +22,36 @@ Paths timed on the same data:
 * ``push(C)``    ``push`` in chunks of C samples (traces consumed and dropped, as a stream);
 * ``step``       ``step(u_k, y_k)`` per sample on a prefix, fed Python floats
   (``u.tolist()`` values, as a streaming user would; the conversion is not timed);
+  ``push(1)`` the same with 1-sample arrays;
 * ``ref eigh``   a plain per-window implementation: for every update build the window's lag
   matrix, center it, form the scatter, ``numpy.linalg.eigh``, take the smallest
-  eigenvector (``_reference_eigh`` below);
+  eigenvector (``_reference_eigh`` below); every speed ratio is against it;
 * ``ref lstsq``  sliding-window least squares (per window ``numpy.linalg.lstsq``).
 
+Comparisons: ``cluster_size=1`` vs the reference with C = 1, ``n_jobs=2`` vs 1 and
+``method='paper'`` vs ``'robust'`` (batch). Exactness: ``method='paper'`` batch vs the
+reference (D, eigenvalues, theta), ``push``/``step`` vs batch, ``python`` vs ``compiled``.
+
+Baseline (``--baseline-src PATH``): the ``src`` directory of an older checkout of clpc, e.g.
+``git worktree add /tmp/clpc-baseline <commit>`` then ``--baseline-src
+/tmp/clpc-baseline/src``. Batch at every ``T``, batch with ``cluster_size=1`` and with
+``method='paper'``, and ``step`` are then measured with both packages (``engine="compiled"``)
+in fresh subprocess workers (this script with ``--worker``; the baseline's with
+``PYTHONPATH=PATH``, so that its ``import clpc`` gets the old code, which is checked): one
+worker per package and round runs them all, ``--baseline-rounds`` (3) rounds with the
+packages' order alternating, the best of each kept; the table "New
+vs baseline" shows both side by side, each against the reference of this run, and the speed
+ratio new/baseline (> 1: the new code is faster); the exactness section compares their
+traces. To benchmark a snapshot rather than the working tree, run the whole script with
+``PYTHONPATH=<snapshot>/src`` (the baseline's workers override it).
+
 Runs with ``T > 1e5`` each run in a fresh subprocess (clean RSS accounting), smaller ones in
-this process; every measurement follows a small warm-up with its engine.
+this process; every measurement follows a small warm-up.
 Timing: ``batch``, ``push(10000)``, ``ref eigh`` and ``step`` at ``T <= 1e6`` keep the best of
 three repetitions (other jobs on the machine only ever slow a run down), runs at
-``T <= 1e5`` repeat for at least 0.3 s; speed ratios use process CPU time, samples/s wall time.
-References longer than ``--ref-cap`` are timed on a prefix and extrapolated linearly (the cost
-per window does not depend on ``T``). Memory: the peak
+``T <= 1e5`` repeat for at least 0.3 s (at most 5 repetitions); speed ratios use process CPU
+time, samples/s wall time. References longer than ``--ref-cap`` are timed on a prefix and
+extrapolated linearly (the cost per window does not depend on ``T``). Memory: the peak
 added over the loaded data, from ``tracemalloc`` (an extra, untimed repetition) for
 ``T <= 1e5`` and from the kernel's peak RSS (``VmHWM`` after resetting it through
 ``/proc/self/clear_refs``; ``ru_maxrss`` otherwise) for larger runs. tracemalloc sees numpy's
@@ -44,16 +62,16 @@ per batch of windows); the RSS figures include them. ``trace`` is the size of th
 
 Usage::
 
-    python benchmarks/bench_clpc.py            # ~2-3 min: T = 1e4 .. 1e7, both engines
-    python benchmarks/bench_clpc.py --quick    # ~15 s: T = 1e4, 1e5, short prefixes
+    python benchmarks/bench_clpc.py            # ~2-3 min: T = 1e4 .. 1e7
+    python benchmarks/bench_clpc.py --quick    # ~30-60 s: T = 1e4, 1e5, short prefixes
+    python benchmarks/bench_clpc.py --baseline-src /tmp/clpc-baseline/src   # + new vs old
     python benchmarks/bench_clpc.py --only-njobs --sizes 1e6   # n_jobs=2 vs 1 only
     python benchmarks/bench_clpc.py --profile --sizes 1e6      # cProfile of run and step
     python benchmarks/bench_clpc.py --sizes 1e4 1e5 1e6
     python benchmarks/bench_clpc.py --huge     # adds a 1e8-sample record streamed from .npy
 
 ``--engine`` picks the engine of ``--profile``, ``--only-njobs`` and ``--huge`` (default
-``auto``: the library's default, compiled when numba is installed; ``CLPC_ENGINE`` is
-honoured as by the library).
+``auto``: the library's default, compiled; ``CLPC_ENGINE`` is honoured as by the library).
 """
 
 from __future__ import annotations
@@ -295,6 +313,7 @@ def worker(spec: dict) -> dict:
         "trace_mb": result["trace_mb"],
         "rss_added_mb": max(peak - base, 0.0),
         "rss_note": "" if can_reset and peak > base_peak - 1e-9 else "peak<=baseline",
+        "clpc_file": clpc.__file__,
     }
     if spec.get("tracemalloc"):
         m = spec.get("tracemalloc_samples", n)
@@ -422,9 +441,10 @@ def _steps(u: list[float], y: list[float], engine: str = "auto") -> None:
         step(u_k, y_k)
 
 
-def _git_state() -> str:
-    """Commit of the working tree and whether src/ differs from it (read-only git calls)."""
-    root = Path(__file__).resolve().parent.parent
+def _git_state(root: Path | None = None) -> str:
+    """Commit of the checkout at ``root`` (default: this one) and whether its src/ differs
+    from it (read-only git calls)."""
+    root = root or Path(__file__).resolve().parent.parent
     try:
         head = subprocess.run(
             ["git", "-C", str(root), "rev-parse", "--short", "HEAD"],
@@ -443,12 +463,67 @@ def _git_state() -> str:
     return f"commit {head}" + (", src/ modified" if dirty else "")
 
 
-def run_worker(spec: dict) -> dict:
-    cmd = [sys.executable, os.path.abspath(__file__), "--worker", json.dumps(spec)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+def run_worker(spec: dict, pythonpath: str | None = None, flag: str = "--worker") -> dict:
+    """Run ``spec`` in a fresh interpreter (this script with ``flag``).
+
+    ``pythonpath``: the ``src`` directory of another clpc checkout; the worker then runs
+    with ``PYTHONPATH`` set to it alone, so its ``import clpc`` gets that code (it comes
+    before the installed, editable package on ``sys.path``); checked from the worker's
+    answer.
+    """
+    cmd = [sys.executable, os.path.abspath(__file__), flag, json.dumps(spec)]
+    env = None
+    if pythonpath is not None:
+        env = {**os.environ, "PYTHONPATH": pythonpath}
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     if proc.returncode != 0:
         raise RuntimeError(f"worker {spec} failed:\n{proc.stderr}")
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    first = out[0] if isinstance(out, list) else out
+    if pythonpath is not None and "clpc_file" in first:
+        got, want = Path(first["clpc_file"]).resolve(), Path(pythonpath).resolve()
+        if want not in got.parents:
+            raise RuntimeError(f"worker imported clpc from {got}, not from {want}")
+    return out
+
+
+def prime_worker(spec: dict) -> dict:
+    """First use of the clpc on ``sys.path`` in this process: loads (or compiles) its kernels.
+
+    Runs ``run``, ``push`` and ``step`` with ``spec["engine"]`` once, so that a later worker
+    never compiles (numba caches on disk); returns the time it took and where clpc is.
+    """
+    import clpc
+
+    u, y = load(Path(spec["workdir"]), 3000)
+    t0 = time.perf_counter()
+    kw = {"method": spec.get("method", "robust"), "engine": spec["engine"]}
+    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw).run(u, y)
+    clpc.CLPC(ORDER + 1, WINDOW, 1, **kw).run(u, y)
+    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw)
+    app.push(u[:1000], y[:1000])
+    for u_k, y_k in zip(u[1000:].tolist(), y[1000:].tolist(), strict=True):
+        app.step(u_k, y_k)
+    return {
+        "time": time.perf_counter() - t0,
+        "clpc_file": clpc.__file__,
+        "version": getattr(clpc, "__version__", "?"),
+        "engine": app.engine,
+    }
+
+
+def dump_worker(spec: dict) -> dict:
+    """Robust and 'paper' batch traces of the first ``n`` samples, saved to ``spec["out"]``."""
+    import clpc
+
+    u, y = load(Path(spec["workdir"]), spec["n"])
+    arrays = {}
+    for method in ("robust", "paper"):
+        tr = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method, engine=spec["engine"]).run(u, y)
+        for key in ("theta", "theta_estimate", "D", "accepted"):
+            arrays[f"{method}_{key}"] = np.asarray(getattr(tr, key))
+    np.savez(spec["out"], **arrays)
+    return {"clpc_file": clpc.__file__}
 
 
 # ====================================================================== formatting
@@ -478,7 +553,7 @@ def table(head: list[str], rows: list[list[str]]) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description="CLPC appraiser benchmark (issue item 7)")
     ap.add_argument(
-        "--quick", action="store_true", help="~15 s run: T = 1e4, 1e5, shorter prefixes"
+        "--quick", action="store_true", help="~1 min run: T = 1e4, 1e5, shorter prefixes"
     )
     ap.add_argument(
         "--huge",
@@ -525,40 +600,75 @@ def main(argv: list[str] | None = None) -> int:
         help="only the n_jobs=2 vs 1 comparison (batch, T = max of --sizes capped at 1e6)",
     )
     ap.add_argument(
-        "--numpy-max",
+        "--python-max",
         type=float,
-        default=1e7,
-        help="largest T for the numpy engine's batch and push(10000) rows (default 1e7)",
+        default=1e4,
+        help="the uncompiled engine='python' (debugging only, very slow) gets a batch row at "
+        "the sizes T <= this (default 1e4; 0: none)",
+    )
+    ap.add_argument(
+        "--baseline-src",
+        default=None,
+        metavar="PATH",
+        help="the src directory of an older clpc checkout (e.g. a git worktree); batch and "
+        "step are then also measured with it, in subprocess workers with PYTHONPATH=PATH, "
+        "and shown new vs baseline",
+    )
+    ap.add_argument(
+        "--baseline-rounds",
+        type=int,
+        default=3,
+        help="rounds of the new vs baseline measurements, each a worker per package, their "
+        "order alternating; the best of each package is kept (default 3)",
     )
     ap.add_argument(
         "--engine",
-        choices=["auto", "compiled", "numpy"],
+        choices=["auto", "compiled", "python"],
         default="auto",
         help="engine of --profile, --only-njobs and --huge (default auto: the library's "
-        "default, compiled when numba is installed)",
+        "default, compiled)",
     )
     ap.add_argument("--workdir", default=None, help="where the data files go (default: temp)")
     ap.add_argument("--keep-data", action="store_true", help="keep the data files (--workdir)")
     ap.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--huge-worker", default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--prime-worker", default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--dump-worker", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
 
     if args.worker:
-        print(json.dumps(worker(json.loads(args.worker))))
+        spec = json.loads(args.worker)
+        if "multi" in spec:  # several measurements, one after the other, in this process
+            print(json.dumps([worker(s) for s in spec["multi"]]))
+        else:
+            print(json.dumps(worker(spec)))
         return 0
     if args.huge_worker:
         print(json.dumps(huge_worker(json.loads(args.huge_worker))))
         return 0
+    if args.prime_worker:
+        print(json.dumps(prime_worker(json.loads(args.prime_worker))))
+        return 0
+    if args.dump_worker:
+        print(json.dumps(dump_worker(json.loads(args.dump_worker))))
+        return 0
+
+    import importlib.util
 
     import clpc
-    from clpc.appraiser import numba_available
+
+    if importlib.util.find_spec("numba") is None:
+        raise SystemExit("numba is not installed: the compiled engine (the default) needs it")
+    baseline = str(Path(args.baseline_src).resolve()) if args.baseline_src else None
+    if baseline is not None and not (Path(baseline) / "clpc" / "__init__.py").is_file():
+        raise SystemExit(f"--baseline-src {args.baseline_src}: no clpc/__init__.py there")
 
     default_sizes = [1e4, 1e5] if args.quick else [1e4, 1e5, 1e6, 1e7]
     sizes = [int(s) for s in (args.sizes or default_sizes)]
     sizes = sorted(set(sizes))
     ref_cap = int(args.ref_cap or (2e4 if args.quick else 1e6))
     slow_max = int(args.slow_max)
-    numpy_max = int(args.numpy_max)
+    python_max = int(args.python_max)
     step_n = int(args.step_samples or (3e3 if args.quick else 2e4))
     t_cmp = min(max(sizes), int(1e6))  # n_jobs, method comparisons
     t_c1 = int(5e3 if args.quick else 1e5)  # cluster_size = 1
@@ -566,10 +676,11 @@ def main(argv: list[str] | None = None) -> int:
     t_rep = 0.5 if args.quick else 3.0  # repeat the n_jobs/method runs for at least this long
     n_data = max([*sizes, step_n, t_c1, t_check])
 
-    # engines: "compiled" (numba) when installed, and the numpy engine
-    engines = ["compiled", "numpy"] if numba_available() else ["numpy"]
+    # the compiled engine is measured throughout; engine="python" runs the same source
+    # uncompiled (debugging only, ~100x slower): one batch row at T <= --python-max
+    engines = ["compiled"]
     default_engine = clpc.CLPC().engine  # what engine="auto" gives (CLPC_ENGINE honoured)
-    main_engine = engines[0]  # the comparisons that run on one engine only
+    main_engine = engines[0]
     sel_engine = clpc.CLPC(engine=args.engine).engine  # --profile / --only-njobs / --huge
 
     def eng_name(e: str) -> str:
@@ -592,7 +703,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     cli = " ".join(sys.argv[1:] if argv is None else argv)
     print(f"command: python benchmarks/bench_clpc.py {cli}")
-    print(f"clpc: {clpc.__file__} ({_git_state()})")
+    print(f"clpc: {clpc.__file__} ({_git_state(Path(clpc.__file__).resolve().parents[2])})")
     print(f"load average at start: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     print(
         f"data: white Gaussian u -> ARX A={DEN.tolist()}, B={NUM.tolist()}, "
@@ -600,20 +711,33 @@ def main(argv: list[str] | None = None) -> int:
         "method='robust' unless stated"
     )
     print(
-        f"engines: {', '.join(engines)}; engine='auto' gives {default_engine!r}"
+        f"engines: compiled; python (uncompiled, batch at T <= {fmt_n(python_max)} only); "
+        f"engine='auto' gives {default_engine!r}"
         + (f" (CLPC_ENGINE={os.environ['CLPC_ENGINE']})" if os.environ.get("CLPC_ENGINE") else "")
     )
+    if baseline is not None:
+        print(f"baseline: {baseline} ({_git_state(Path(baseline).parent)}), engine='compiled'")
     gen0 = time.perf_counter()
     generate(workdir / "u.bin", workdir / "y.bin", n_data)
     print(f"(generated {fmt_n(n_data)} samples in {time.perf_counter() - gen0:.1f} s)")
-    if "compiled" in engines:
-        # the first use in an environment compiles the kernel (~13 s; numba caches it on disk)
-        u0, y0 = load(workdir, 5000)
-        c0 = time.perf_counter()
-        clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="compiled").run(u0, y0)
+    # the first use in an environment compiles the kernels (numba caches them on disk, under
+    # src/clpc/**/__pycache__): load them once here and in a fresh process per package, so
+    # no worker ever compiles (each also warms up before timing)
+    u0, y0 = load(workdir, 5000)
+    c0 = time.perf_counter()
+    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="compiled").run(u0, y0)
+    c_here = time.perf_counter() - c0
+    prime = {"workdir": str(workdir), "engine": "compiled"}
+    c_new = run_worker(prime, flag="--prime-worker")["time"]
+    print(
+        f"(compiled engine: first call {c_here:.1f} s in this process, {c_new:.1f} s in a fresh "
+        "one (run, push, step), loading or compiling the kernels; never timed below)"
+    )
+    if baseline is not None:
+        pb = run_worker(prime, pythonpath=baseline, flag="--prime-worker")
         print(
-            f"(compiled engine: first call in this process {time.perf_counter() - c0:.1f} s, "
-            "loading or compiling the kernel; never timed below)"
+            f"(baseline {pb['version']} from {pb['clpc_file']}, engine {pb['engine']!r}: first "
+            f"calls in a fresh process {pb['time']:.1f} s; never timed below)"
         )
     print()
 
@@ -685,19 +809,18 @@ def main(argv: list[str] | None = None) -> int:
     # Ratios use process CPU time (robust to other jobs on the machine); samples/s use wall.
     results: dict[tuple[str, str, int], dict] = {}  # (label, engine, T)
     ref_cpu: dict[int, tuple[float, str]] = {}  # CPU seconds per sample of ref eigh
-    skipped: list[str] = []
     rows = []
     for n in sizes:
         paths: list[tuple[str, str, dict]] = [("batch", e, {}) for e in engines]
+        if n <= python_max:  # one repetition, no memory: it is slow
+            paths.append(
+                ("batch", "python", {"min_time": 0.0, "min_reps": 1, "tracemalloc": False})
+            )
         if n <= slow_max:
             paths.append(("push(100)", main_engine, {"chunk": 100}))
         paths += [("push(10000)", e, {"chunk": 10000}) for e in engines]
         if n <= slow_max:
             paths += [("ref eigh", "-", {}), ("ref lstsq", "-", {})]
-        if n > numpy_max and "compiled" in engines:
-            gone = [p for p in paths if p[1] == "numpy"]
-            paths = [p for p in paths if p[1] != "numpy"]
-            skipped += [f"{label} at T={fmt_n(n)}" for label, _, _ in gone]
         for label, eng, kw in paths:
             kind = {"batch": "batch", "ref eigh": "ref_eigh", "ref lstsq": "ref_lstsq"}.get(
                 label, "push"
@@ -722,6 +845,10 @@ def main(argv: list[str] | None = None) -> int:
             note = res["note"]
             if not label.startswith("ref") and ref_cpu.get(n, (0, ""))[1]:
                 note = "ratio vs ref " + ref_cpu[n][1]
+            memory = [mem_cell(res), f"{res['trace_mb']:.1f}", work_cell(res)]
+            if eng == "python":
+                memory = ["-", f"{res['trace_mb']:.1f}", "-"]
+                note = "uncompiled (debugging only), one repetition" + (note and f"; {note}")
             rows.append(
                 [
                     label,
@@ -730,10 +857,8 @@ def main(argv: list[str] | None = None) -> int:
                     f"{res['wall']:.3f}",
                     f"{res['cpu_t']:.3f}",
                     fmt_rate(n / res["wall"]),
-                    f"{res['ratio']:.1f}x",
-                    mem_cell(res),
-                    f"{res['trace_mb']:.1f}",
-                    work_cell(res),
+                    f"{res['ratio']:.2f}x" if res["ratio"] < 1 else f"{res['ratio']:.1f}x",
+                    *memory,
                     note,
                 ]
             )
@@ -790,11 +915,6 @@ def main(argv: list[str] | None = None) -> int:
         "traces are consumed and dropped); 'working' = peak added - trace. "
         "MB = 2^20 bytes throughout."
     )
-    if skipped:
-        print(
-            f"\nNot run (numpy engine above --numpy-max={fmt_n(numpy_max)}, to bound the "
-            f"run time): {', '.join(skipped)}."
-        )
     print()
 
     # ------------------------------------------------------------ comparisons
@@ -862,6 +982,96 @@ def main(argv: list[str] | None = None) -> int:
     )
     print()
 
+    # ------------------------------------------------------------ new vs baseline
+    base_ratio: dict[str, float] = {}  # path -> speed new/baseline (CPU)
+    if baseline is not None:
+
+        def ref_per_sample(n: int) -> float:
+            # the reference's cost per window does not depend on T
+            return ref_cpu[n][0] if n in ref_cpu else ref_cpu[max(ref_cpu)][0]
+
+        pairs: list[tuple[str, str, int, dict, float]] = [
+            ("batch", "batch", n, {}, ref_per_sample(n) * n) for n in sizes
+        ]
+        pairs.append(("batch cluster_size=1", "batch", t_c1, {"cluster": 1}, c1r_cpu))
+        paper_ref = ref_per_sample(t_cmp) * t_cmp
+        pairs.append(("batch method='paper'", "batch", t_cmp, {"method": "paper"}, paper_ref))
+        pairs.append(("step", "step", step_n, {}, ref_per_sample(min(ref_cpu)) * step_n))
+        specs = [
+            {
+                "kind": kind,
+                "n": n,
+                "workdir": str(workdir),
+                "engine": "compiled",
+                "min_time": 0.3 if n <= 1e5 else 0.0,
+                "min_reps": 3 if n <= 1e6 else 1,
+                **kw,
+            }
+            for _, kind, n, kw, _ in pairs
+        ]
+        # one worker per package and round runs every measurement (no RSS is reported here,
+        # so they can share a process); the packages alternate, first new then baseline,
+        # then the other way round, so that drift in the machine's load hits both
+        rounds = max(args.baseline_rounds, 1)
+        best = {pkg: [{"cpu": np.inf, "time": np.inf} for _ in pairs] for pkg in ("new", "old")}
+        for r in range(rounds):
+            order = [("new", None), ("old", baseline)]
+            for pkg, path in order if r % 2 == 0 else order[::-1]:
+                for b, res in zip(best[pkg], run_worker({"multi": specs}, path), strict=True):
+                    b["cpu"], b["time"] = min(b["cpu"], res["cpu"]), min(b["time"], res["time"])
+        base_rows = []
+        for (label, kind, n, _, ref_t), new, old in zip(
+            pairs, best["new"], best["old"], strict=True
+        ):
+            key = f"{label} T={fmt_n(n)}"
+            base_ratio[key] = old["cpu"] / new["cpu"]
+            note = ""
+            if kind == "step":
+                note = (
+                    f"{new['cpu'] / n * 1e6:.1f} vs {old['cpu'] / n * 1e6:.1f} us/sample CPU, "
+                    "Python floats"
+                )
+            base_rows.append(
+                [
+                    label,
+                    fmt_n(n),
+                    f"{new['cpu']:.3f}",
+                    f"{old['cpu']:.3f}",
+                    f"{fmt_rate(n / new['time'])} vs {fmt_rate(n / old['time'])}",
+                    f"{ref_t / new['cpu']:.2f}x",
+                    f"{ref_t / old['cpu']:.2f}x",
+                    f"**{old['cpu'] / new['cpu']:.2f}x**",
+                    f"{old['time'] / new['time']:.2f}x",
+                    note,
+                ]
+            )
+        print(f"## New vs baseline ({baseline})\n")
+        print(
+            table(
+                [
+                    "path",
+                    "T",
+                    "new CPU [s]",
+                    "baseline CPU [s]",
+                    "samples/s wall (new vs baseline)",
+                    "new vs ref eigh (CPU)",
+                    "baseline vs ref eigh (CPU)",
+                    "speed new/baseline (CPU)",
+                    "speed new/baseline (wall)",
+                    "note",
+                ],
+                base_rows,
+            )
+        )
+        print(
+            f"\nBoth packages with engine='compiled', in fresh subprocess workers (this "
+            f"script, PYTHONPATH={baseline} for the baseline), one per package and round "
+            f"running every row; {rounds} rounds, the packages' order alternating, the best "
+            "of each kept (each row: warm-up, then best of up to 5 repetitions); 'vs ref eigh' "
+            "against the reference timed above in this run. speed new/baseline > 1: the new "
+            "code is faster.\n"
+        )
+
     # ------------------------------------------------------------ exactness
     u, y = load(workdir, t_check)
     th_ref, eig_ref = _reference_eigh(u, y)
@@ -873,13 +1083,14 @@ def main(argv: list[str] | None = None) -> int:
     u_l, y_l = u[:ns].tolist(), y[:ns].tolist()
     exact_ok: dict[str, bool] = {}
     robust: dict[str, clpc.Trace] = {}
+    paper: dict[str, clpc.Trace] = {}
     print(f"## Exactness (T={fmt_n(t_check)}, {th_ref.shape[0]} updates)\n")
     for eng in engines:
 
         def make(method: str = "robust", eng: str = eng) -> clpc.CLPC:
             return clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method, engine=eng)
 
-        tr = make("paper").run(u, y)
+        tr = paper[eng] = make("paper").run(u, y)
         assert len(tr) == th_ref.shape[0], (len(tr), th_ref.shape)
         d_dev = np.abs(tr.D - d_ref) / np.abs(d_ref)
         th_b = tr.theta_estimate
@@ -920,16 +1131,51 @@ def main(argv: list[str] | None = None) -> int:
             f"{np.abs(tr_s.theta - tr_rs.theta).max():.1e}, max |D diff| = "
             f"{np.abs(tr_s.D - tr_rs.D).max():.1e}"
         )
-    if len(robust) == 2:
-        a, b = robust["compiled"], robust["numpy"]
-        d_rel = np.abs(a.D - b.D) / np.abs(b.D)
-        agree = np.mean(a.accepted == b.accepted)
-        print(
-            f"\ncompiled vs numpy engine (robust batch): max |theta diff| = "
-            f"{np.abs(a.theta - b.theta).max():.1e}, max |theta_estimate diff| = "
-            f"{np.abs(a.theta_estimate - b.theta_estimate).max():.1e}, max rel. |D diff| = "
-            f"{d_rel.max():.1e}; 'accepted' agrees on {100 * agree:.2f} % of the updates"
+
+    def agreement(a: dict, b: dict) -> str:
+        if a["D"].shape != b["D"].shape:
+            return f"different numbers of updates ({a['D'].size} vs {b['D'].size})"
+        d_rel = np.abs(a["D"] - b["D"]) / np.abs(b["D"])
+        return (
+            f"max |theta diff| = {np.abs(a['theta'] - b['theta']).max():.1e}, max "
+            f"|theta_estimate diff| = "
+            f"{np.abs(a['theta_estimate'] - b['theta_estimate']).max():.1e}, max rel. |D "
+            f"diff| = {d_rel.max():.1e}; 'accepted' agrees on "
+            f"{100 * np.mean(a['accepted'] == b['accepted']):.2f} % of the updates"
         )
+
+    def arrays(tr: clpc.Trace) -> dict:
+        return {k: np.asarray(getattr(tr, k)) for k in ("theta", "theta_estimate", "D", "accepted")}
+
+    if python_max > 0:
+        n_py = min(t_check, 5000)
+        for method in ("robust", "paper"):
+            kw_py = {"method": method}
+            a = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="python", **kw_py).run(
+                u[:n_py], y[:n_py]
+            )
+            b = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="compiled", **kw_py).run(
+                u[:n_py], y[:n_py]
+            )
+            print(
+                f"- python vs compiled engine ({method} batch, T={fmt_n(n_py)}): "
+                f"{agreement(arrays(a), arrays(b))}"
+            )
+    if baseline is not None:
+        out = workdir / "baseline-trace.npz"
+        run_worker(
+            {"workdir": str(workdir), "n": t_check, "engine": "compiled", "out": str(out)},
+            pythonpath=baseline,
+            flag="--dump-worker",
+        )
+        with np.load(out) as z:
+            old = {k: z[k] for k in z.files}
+        for method, trs in (("robust", robust), ("paper", paper)):
+            b = {k[len(method) + 1 :]: v for k, v in old.items() if k.startswith(method + "_")}
+            print(
+                f"- new vs baseline (compiled engines, {method} batch, T={fmt_n(t_check)}): "
+                f"{agreement(arrays(trs[main_engine]), b)}"
+            )
     err_ls = np.linalg.norm(ls_ref[-100:].mean(0) - _true_theta())
     errs = ", ".join(
         f"robust LPC ({eng}) {np.linalg.norm(tr.theta_estimate[-100:].mean(0) - _true_theta()):.3f}"
@@ -1050,6 +1296,16 @@ def main(argv: list[str] | None = None) -> int:
             status(exact_ok),
         ]
     )
+    if base_ratio:
+        low = min(base_ratio.values())
+        tgt.append(
+            [
+                "batch and step speed not lower than the baseline (same run, CPU)",
+                "speed new/baseline: "
+                + ", ".join(f"{v:.2f}x ({k})" for k, v in base_ratio.items()),
+                "MET" if low >= 1.0 else ("WITHIN NOISE (>= 0.95)" if low >= 0.95 else "MISSED"),
+            ]
+        )
     print("## Targets (issue 'CLPC appraiser', item 7)\n")
     print(
         table(

@@ -8,57 +8,14 @@ it window by window; it is never imported by the package.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from clpc.core.rules import RobustRule
+from clpc.lpc.solve import SolveResult  # the container only; every number is computed here
 
 _LOG_2PI = float(np.log(2.0 * np.pi))
-
-
-@dataclass(frozen=True)
-class SolveResult:
-    """Batched LPC solution; every field has leading shape ``batch``.
-
-    Attributes
-    ----------
-    theta : ndarray, shape (batch..., p)
-        Unit-norm parameter vector ``[a; b]`` with ``a0 >= 0`` (paper convention).
-    eigenvalues : ndarray, shape (batch..., p)
-        Eigenvalues of the paper's scatter matrix ``A`` (eq. 27), ascending.
-    solved_eigenvalues : ndarray, shape (batch..., p)
-        Eigenvalues of the problem actually solved (whitened ``A``), ascending.
-    c : ndarray, shape (batch...)
-        Mean of the equation error, ``c = Z^T theta`` (eq. 24).
-    noise_variance : ndarray, shape (batch...)
-        Maximum-likelihood variance of ``r(n) = z_n^T theta``: ``theta^T A theta / n``.
-    n_null : ndarray of int, shape (batch...)
-        Dimension of the near-null subspace the solution was taken from (1 = generic).
-    n_input_relations : ndarray of int, shape (batch...)
-        Near-null relations that involve (almost) no output: the input alone satisfies
-        them, so it is not persistently exciting of the model's order.
-    separation : ndarray, shape (batch...)
-        Solved eigenvalue of the solution over the next eigenvalue outside the near-null
-        subspace (small: well determined; near 1: not determined by the data).
-    degenerate : ndarray of bool, shape (batch...)
-        The scatter matrix is (numerically) zero or has a constant channel: nothing to fit.
-    a0_weight : ndarray, shape (batch...)
-        ``|y(n)|`` component of the solution in the solved (whitened) problem, unit-free;
-        near 0 the solution does not determine ``y(n)`` and has no monic form.
-    """
-
-    theta: np.ndarray
-    eigenvalues: np.ndarray
-    solved_eigenvalues: np.ndarray
-    c: np.ndarray
-    noise_variance: np.ndarray
-    n_null: np.ndarray
-    n_input_relations: np.ndarray
-    separation: np.ndarray
-    degenerate: np.ndarray
-    a0_weight: np.ndarray
 
 
 def channel_scales(scatter: np.ndarray, n_rows: np.ndarray, blocks: list[slice]) -> np.ndarray:
