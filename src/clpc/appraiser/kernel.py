@@ -38,17 +38,15 @@ from clpc.core.rules import (
     NO_TRANSFORM,
     SolveSettings,
     accepts,
-    channel_scales,
     eig_ratio,
     index_j,
     is_determined,
     is_excited,
     is_trusted,
     likelihood_variance,
-    solve_from_eig,
-    solved_matrix,
 )
 from clpc.core.small_eigh import sym_eig
+from clpc.core.solution import channel_scales, solve_from_eig, solved_matrix
 
 __all__ = ["FsmOutput", "FsmSettings", "FsmState", "Solved", "WindowPlan", "fsm_output"]
 
@@ -194,23 +192,19 @@ def piece_stats(
 
 
 @kernel
-def piece_step(
-    samples: np.ndarray, chan: np.ndarray, first: int, rows: tuple[int, int], out: np.ndarray
-) -> None:
-    """Each column's smallest nonzero change over the newest samples of rows ``rows``.
+def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, int]) -> float:
+    """The smallest nonzero change of one channel over the newest samples of rows ``rows``.
 
-    The quantization step of a channel as far as the piece shows (``inf`` when it does not
-    change): row ``r``'s newest sample ``samples[first + r]`` against the one before it.
+    Its quantization step as far as the piece shows (``inf`` when it does not change):
+    row ``r``'s newest sample ``samples[first + r]`` against the one before it.
     """
     lo, hi = rows
-    for a in range(out.shape[0]):
-        best = math.inf
-        ch = chan[a]
-        for r in range(lo, hi):
-            d = abs(samples[first + r, ch] - samples[first + r - 1, ch])
-            if d > 0 and d < best:
-                best = d
-        out[a] = best
+    best = math.inf
+    for r in range(lo, hi):
+        d = abs(samples[first + r, channel] - samples[first + r - 1, channel])
+        if d > 0 and d < best:
+            best = d
+    return best
 
 
 @kernel
@@ -328,9 +322,7 @@ def solve_windows(
     n_blocks = j0 + count - 1 - b_lo  # block j - 1 is the newest of window j
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
-    b_step = np.empty((n_blocks, p))
-    t_step = np.empty(p)
-    step = np.empty(p)
+    b_step = np.empty(n_blocks)
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
     dev = np.empty((window // cluster + 2, p))
@@ -344,7 +336,7 @@ def solve_windows(
         for b in range(n_blocks):
             lo = (b_lo + b) * cluster
             piece_stats(samples, chan, lag, first, (lo, lo + cluster), z, (b_mean[b], b_scat[b]))
-            piece_step(samples, chan, first, (lo, lo + cluster), b_step[b])
+            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + cluster))
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -369,11 +361,10 @@ def solve_windows(
                 piece_stats(
                     samples, chan, lag, first, (start, full_lo * cluster), z, (t_mean, t_scat)
                 )
-                piece_step(samples, chan, first, (start, full_lo * cluster), t_step)
-            for a in range(p):
-                step[a] = t_step[a] if t_size > 0 else math.inf
-                for b in range(full_lo - b_lo, j - b_lo):
-                    step[a] = min(step[a], b_step[b, a])
+            # the output's quantization step in the window (column 0 is y(n))
+            step = piece_step(samples, chan[0], first, (start, full_lo * cluster))
+            for b in range(full_lo - b_lo, j - b_lo):
+                step = min(step, b_step[b])
             n_w = merge(
                 (b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster),
                 (t_size, t_mean, t_scat),

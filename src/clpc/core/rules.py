@@ -32,11 +32,9 @@ __all__ = [
     "RobustRule",
     "SolveSettings",
     "accepts",
-    "degeneracy_ratio",
     "is_determined",
     "is_excited",
     "is_trusted",
-    "solve_from_eig",
     "transform_mode",
 ]
 
@@ -166,311 +164,6 @@ def solve_settings(
     )
 
 
-# ------------------------------------------------------------------ the solved problem
-@kernel
-def channel_scales(
-    scat: np.ndarray, n_rows: float, col_channel: np.ndarray, n_channels: int, scales: np.ndarray
-) -> None:
-    """Per-column scale: the standard deviation of each channel (mean over its lags).
-
-    A constant channel gets scale 1 (it is flagged degenerate by :func:`is_degenerate`).
-    """
-    p = scat.shape[0]
-    n_safe = max(n_rows, 1.0)
-    for ch in range(n_channels):
-        acc = 0.0
-        cnt = 0
-        for a in range(p):
-            if col_channel[a] == ch:
-                acc += scat[a, a]
-                cnt += 1
-        std = math.sqrt(max(acc / max(cnt, 1), 0.0) / n_safe)
-        for a in range(p):
-            if col_channel[a] == ch:
-                scales[a] = std if std > 0 else 1.0
-
-
-@kernel
-def solved_matrix(
-    scat: np.ndarray,
-    mode: int,
-    fixed: np.ndarray,
-    scales: np.ndarray,
-    tmat: np.ndarray,
-    mat: np.ndarray,
-) -> None:
-    """Fill ``tmat`` with ``T`` and ``mat`` with the symmetric ``T^T A T``."""
-    p = scat.shape[0]
-    for a in range(p):
-        for b in range(p):
-            if mode == FIXED_TRANSFORM:
-                tmat[a, b] = fixed[a, b]
-            elif mode == CHANNEL_SCALES:
-                tmat[a, b] = 1.0 / scales[a] if a == b else 0.0
-            else:
-                tmat[a, b] = 1.0 if a == b else 0.0
-    if mode == CHANNEL_SCALES:
-        for a in range(p):
-            for b in range(p):
-                mat[a, b] = scat[a, b] / (scales[a] * scales[b])
-    elif mode == FIXED_TRANSFORM:
-        for a in range(p):
-            for b in range(p):
-                acc = 0.0
-                for k in range(p):
-                    for m in range(p):
-                        acc += tmat[k, a] * scat[k, m] * tmat[m, b]
-                mat[a, b] = acc
-        for a in range(p):
-            for b in range(a):
-                sym = 0.5 * (mat[a, b] + mat[b, a])
-                mat[a, b] = sym
-                mat[b, a] = sym
-    else:
-        for a in range(p):
-            for b in range(p):
-                mat[a, b] = scat[a, b]
-
-
-@kernel
-def is_degenerate(
-    scat: np.ndarray,
-    mean: np.ndarray,
-    n_rows: float,
-    top: float,
-    col_channel: np.ndarray,
-    n_channels: int,
-) -> bool:
-    """Nothing varies (``lambda_max <= 0``) or a channel is constant."""
-    if not top > 0:
-        return True
-    p = scat.shape[0]
-    n_safe = max(n_rows, 1.0)
-    for ch in range(n_channels):
-        var = -1.0
-        size = 0.0
-        for a in range(p):
-            if col_channel[a] == ch:
-                var = max(var, scat[a, a])
-                size = max(size, abs(mean[a]))
-        if var <= CONSTANT_CHANNEL_FRACTION * max(top, 1e-300):
-            return True
-        if var / n_safe <= (CONSTANT_CHANNEL_RELATIVE_STD * size) ** 2:
-            return True
-    return False
-
-
-@kernel
-def degeneracy_ratio(fixed: float, p: int, n_rows: float) -> float:
-    """``fixed`` if > 0, else the Marchenko-Pastur edge ratio for ``p`` columns, ``n`` rows."""
-    if fixed > 0:
-        return fixed
-    x = math.sqrt(p / max(n_rows, 1.0))
-    if not x < 1:
-        return MAX_DEGENERACY_RATIO
-    return min(((1 + x) / max(1 - x, 1e-12)) ** 2, MAX_DEGENERACY_RATIO)
-
-
-@kernel
-def ratio(num: float, den: float) -> float:
-    """``num / den`` clipped to [0, 1]; 1 when ``den`` is not positive."""
-    num = max(num, 0.0)
-    den = max(den, 0.0)
-    if not den > 0:
-        return 1.0
-    return min(num / den, 1.0)
-
-
-# ------------------------------------------------------------------ picking the vector
-@kernel
-def unit_free_weights(
-    vec: np.ndarray, tmat: np.ndarray, scales: np.ndarray, n_out_cols: int
-) -> tuple[float, float]:
-    """The ``y(n)`` weight and the output-block weight of ``theta = T v``, free of units.
-
-    With ``s`` the channels' standard deviations (per column), ``w = diag(s) T v`` is the
-    relation in units of each channel's own spread: ``|w_0| / ||w||`` (the ``y(n)``
-    weight) and ``||w_y||^2 / ||w||^2`` (the output block's share) do not change when a
-    channel is rescaled. An input-only relation has ``y(n)`` weight 0 in any units.
-    """
-    p = vec.shape[0]
-    total = 0.0
-    out = 0.0
-    first = 0.0
-    for a in range(p):
-        acc = 0.0
-        for b in range(p):
-            acc += tmat[a, b] * vec[b]
-        w = scales[a] * acc
-        total += w * w
-        if a < n_out_cols:
-            out += w * w
-        if a == 0:
-            first = abs(w)
-    if not total > 0:
-        return 0.0, 0.0
-    return first / math.sqrt(total), out / total
-
-
-@kernel
-def pick_paper(
-    eig: tuple[np.ndarray, np.ndarray],
-    weights: tuple[np.ndarray, np.ndarray],
-    s: SolveSettings,
-    phi: np.ndarray,
-) -> tuple[int, int, float]:
-    """The literal last principal component; returns ``(n_null, n_input, separation)``."""
-    vals, vecs = eig
-    p = vals.shape[0]
-    for a in range(p):
-        phi[a] = vecs[a, 0]
-    n_input = 1 if weights[1][0] < s.min_output_weight else 0
-    return 1, n_input, ratio(vals[0], vals[1] if p > 1 else vals[0])
-
-
-@kernel
-def pick_robust(
-    eig: tuple[np.ndarray, np.ndarray],
-    weights: tuple[np.ndarray, np.ndarray],
-    s: SolveSettings,
-    n_rows: float,
-    phi: np.ndarray,
-) -> tuple[int, int, float]:
-    """Minimum-norm ``a0 = 1`` vector in the near-null subspace of the solved problem.
-
-    ``weights = (a0_weights, output_weights)`` of each eigenvector, unit-free
-    (:func:`unit_free_weights`). The first eigenvector (ascending) whose ``y(n)`` weight
-    is at least ``min_a0_weight`` is the candidate (none: the one with the largest); the
-    near-null subspace runs from the smallest eigenvalue through every eigenvalue within
-    the degeneracy ratio of the candidate's; ``phi`` is the projection of ``e_a0`` onto it.
-    Returns ``(n_null, n_input, separation)``.
-    """
-    vals, vecs = eig
-    a0w, outw = weights
-    p = vals.shape[0]
-    lim = degeneracy_ratio(s.degeneracy_ratio, p, n_rows)
-    first = -1
-    for i in range(p):
-        if a0w[i] >= s.min_a0_weight:
-            first = i
-            break
-    if first < 0:
-        best = -1.0
-        for i in range(p):
-            if a0w[i] > best:
-                best = a0w[i]
-                first = i
-    lam_s = max(vals[first], s.zero_tol * max(vals[p - 1], 0.0))
-    last = p - 1
-    for i in range(first + 1, p):
-        if not max(vals[i], 0.0) <= lim * lam_s:
-            last = i - 1
-            break
-    for a in range(p):
-        phi[a] = 0.0
-    n_input = 0
-    for i in range(last + 1):
-        w = vecs[0, i]
-        for a in range(p):
-            phi[a] += vecs[a, i] * w
-        if outw[i] < s.min_output_weight:
-            n_input += 1
-    separation = 1.0 if last + 1 >= p else ratio(lam_s, vals[last + 1])
-    return last + 1, n_input, separation
-
-
-@kernel
-def normalise(theta: np.ndarray) -> None:
-    """Unit norm and a deterministic sign: ``a0 > 0`` (else the first nonzero entry > 0)."""
-    p = theta.shape[0]
-    norm = 0.0
-    for a in range(p):
-        norm += theta[a] * theta[a]
-    norm = math.sqrt(norm)
-    for a in range(p):
-        theta[a] = theta[a] / norm if norm > 0 else 0.0
-    sign = 1.0
-    for a in range(p):
-        if abs(theta[a]) > SIGN_PIVOT_TOL:
-            sign = -1.0 if theta[a] < 0 else 1.0
-            break
-    for a in range(p):
-        theta[a] = sign * theta[a]
-
-
-@kernel
-def solve_from_eig(
-    scat: np.ndarray,
-    mean: np.ndarray,
-    n_rows: float,
-    eig: tuple[np.ndarray, np.ndarray, np.ndarray],
-    transform: tuple[np.ndarray, np.ndarray],
-    s: SolveSettings,
-    col_channel: np.ndarray,
-    out: tuple[np.ndarray, np.ndarray, np.ndarray],
-) -> tuple[float, float, float, float, int, int, bool]:
-    """The LPC solution of one equation from the eigen-decomposition of its solved problem.
-
-    Parameters
-    ----------
-    scat, mean : ndarray, shape (p, p), (p,)
-        The paper's scatter ``A`` (eq. 27) and mean ``Z`` (eq. 25).
-    n_rows : float
-        Lag vectors behind them.
-    eig : (vals, vecs, raw)
-        Ascending eigenvalues (p,) and eigenvectors (columns, (p, p)) of ``T^T A T``, and
-        the ascending eigenvalues of ``A`` itself (the paper's, for ``D``).
-    transform : (tmat, scales)
-        ``T`` (p, p), and the channels' standard deviations per column (p,) that make the
-        weights of :func:`unit_free_weights` unit-free.
-    s : SolveSettings
-    col_channel : ndarray of int, shape (p,)
-        Channel block of each column (0 = output).
-    out : (phi, theta, eigenvalues)
-        Work vector (p,), and outputs: unit-norm ``theta`` with ``a0 >= 0`` (zero when
-        degenerate) and the clipped eigenvalues of ``A``.
-
-    Returns
-    -------
-    tuple
-        ``(c, noise_variance, separation, a0_weight, n_null, n_input, degenerate)``.
-    """
-    vals, vecs, raw = eig
-    tmat, scales = transform
-    phi, theta, eigenvalues = out
-    p = scat.shape[0]
-    degenerate = is_degenerate(scat, mean, n_rows, max(raw[p - 1], 0.0), col_channel, s.n_channels)
-    a0w = np.empty(p)
-    outw = np.empty(p)
-    for i in range(p):
-        a0w[i], outw[i] = unit_free_weights(vecs[:, i], tmat, scales, s.n_out_cols)
-    if s.robust:
-        n_null, n_input, separation = pick_robust((vals, vecs), (a0w, outw), s, n_rows, phi)
-    else:
-        n_null, n_input, separation = pick_paper((vals, vecs), (a0w, outw), s, phi)
-    a0_weight = 0.0 if degenerate else unit_free_weights(phi, tmat, scales, s.n_out_cols)[0]
-    for a in range(p):  # theta = T phi
-        acc = 0.0
-        for b in range(p):
-            acc += tmat[a, b] * phi[b]
-        theta[a] = acc
-    normalise(theta)
-    c = 0.0
-    quad = 0.0
-    for a in range(p):
-        if degenerate:
-            theta[a] = 0.0
-        eigenvalues[a] = max(raw[a], 0.0)
-    for a in range(p):
-        c += mean[a] * theta[a]  # eq. 24
-        acc = 0.0
-        for b in range(p):
-            acc += scat[a, b] * theta[b]
-        quad += theta[a] * acc
-    noise_variance = max(quad, 0.0) / max(n_rows, 1.0)
-    return c, noise_variance, separation, a0_weight, n_null, n_input, degenerate
-
-
 # ------------------------------------------------------------------ statistics and verdicts
 @kernel
 def likelihood_variance(noise_variance: float, lambda_max: float, n_rows: float) -> float:
@@ -520,20 +213,20 @@ def trust_rows(p: int, window: int) -> int:
 
 
 @kernel
-def is_excited(scat: np.ndarray, n_rows: float, step: np.ndarray, n_out_cols: int) -> bool:
+def is_excited(scat: np.ndarray, n_rows: float, step: float, n_out_cols: int) -> bool:
     """The output varies by at least :data:`EXCITATION_QUANTA` quantization steps.
 
-    ``step[a]`` is the quantization step of column ``a``'s channel in the window: its
-    smallest nonzero change between consecutive samples (``inf`` when it never changes).
-    Only the output columns (the first ``n_out_cols``) are checked: the output is the
-    measured, quantized signal (a resolver or encoder at rest jitters by a step or two),
-    while an input is often a command with few levels on purpose (a PRBS changes by its
-    whole amplitude, and is exciting).
+    ``step`` is the output's quantization step in the window: its smallest nonzero change
+    between consecutive samples (``inf`` when it never changes). Only the output columns
+    (the first ``n_out_cols``) are checked: the output is the measured, quantized signal (a
+    resolver or encoder at rest jitters by a step or two), while an input is often a
+    command with few levels on purpose (a PRBS changes by its whole amplitude, and is
+    exciting).
     """
     n_safe = max(n_rows, 1.0)
     for a in range(n_out_cols):
         std = math.sqrt(max(scat[a, a], 0.0) / n_safe)
-        if not std >= EXCITATION_QUANTA * step[a]:
+        if not std >= EXCITATION_QUANTA * step:
             return False
     return True
 

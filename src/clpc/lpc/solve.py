@@ -15,7 +15,7 @@ under ``||theta|| = 1`` is the eigenvector of the smallest eigenvalue of ``A``
 ``method="paper"``
     The literal eigenvector of the smallest eigenvalue of ``A`` (no scaling).
 ``method="robust"`` (default)
-    See :func:`clpc.core.rules.pick_robust` and ``docs/method.md``.
+    See :func:`clpc.core.solution.pick_robust` and ``docs/method.md``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core import rules
+from clpc.core import rules, solution
 from clpc.core.jit import compiled
 from clpc.core.rules import (
     NO_TRANSFORM,
@@ -150,8 +150,8 @@ def solve_scatter(
     fixed = np.eye(p) if noise_cov is None else fixed_transform(noise_cov, p)
     settings = solve_settings(rule_, method == "robust", mode, n_output_cols, len(blocks))
     col_channel = _column_channels(blocks, p)
-    scales_of, matrix_of = engine_fn(rules.channel_scales), engine_fn(rules.solved_matrix)
-    finish = engine_fn(rules.solve_from_eig)
+    scales_of, matrix_of = engine_fn(solution.channel_scales), engine_fn(solution.solved_matrix)
+    finish = engine_fn(solution.solve_from_eig)
     out = {
         "theta": np.zeros((k, p)),
         "eigenvalues": np.zeros((k, p)),

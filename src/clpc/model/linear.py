@@ -26,28 +26,12 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
+from clpc.core.polynomials import monic
+from clpc.model import simulation
+from clpc.model.errors import ModelError
 from clpc.model.structure import Structure
 
 __all__ = ["LinearModel", "ModelError"]
-
-
-class ModelError(ValueError):
-    """The requested operation does not exist for this model (e.g. an unstable inverse)."""
-
-
-def _as_2d(x: Any, n_cols: int, name: str) -> tuple[np.ndarray, bool]:
-    arr = np.asarray(x, dtype=np.float64)
-    was_1d = arr.ndim == 1
-    if was_1d:
-        arr = arr[:, None]
-    if arr.ndim != 2 or arr.shape[1] != n_cols:
-        raise ValueError(
-            f"{name} must have shape (n_samples,) or (n_samples, {n_cols}); got {arr.shape}."
-        )
-    if not np.all(np.isfinite(arr)):
-        bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
-        raise ValueError(f"{name} must be finite; the first non-finite sample is at {bad}.")
-    return arr, was_1d
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,25 +96,26 @@ class LinearModel:
             )
         return a0
 
+    def _monic(self) -> tuple[np.ndarray, np.ndarray]:
+        """Both monic polynomials of every output (:func:`clpc.core.polynomials.monic`)."""
+        self._a0()  # a0 must be nonzero
+        s = self.structure
+        den = np.empty((self.n_outputs, s.na + 1))
+        num = np.empty((self.n_outputs, self.n_inputs, s.nk + s.nb + 1))
+        for j in range(self.n_outputs):
+            pair = j if self.mode == "paired" else -1
+            monic(np.asarray(self.theta[j], float), s.na, s.nb, s.nk, pair, den[j], num[j])
+        return den, num
+
     @property
     def denominators(self) -> np.ndarray:
         """Monic ``A_j(z)`` coefficients, ascending powers of ``z^-1``: shape (n_out, na+1)."""
-        na = self.structure.na
-        return self.theta[:, : na + 1] / self._a0()[:, None]
+        return self._monic()[0]
 
     @property
     def numerators(self) -> np.ndarray:
         """``-B_ji(z)/a0`` with ``nk`` leading zeros: shape (n_out, n_in, nk+nb+1)."""
-        s = self.structure
-        a0 = self._a0()
-        n_out = self.n_outputs
-        nums = np.zeros((n_out, self.n_inputs, s.nk + s.nb + 1))
-        for j in range(n_out):
-            b = self.theta[j, s.na + 1 :].reshape(-1, s.nb + 1)
-            cols = [j] if self.mode == "paired" else list(range(self.n_inputs))
-            for blk, i in enumerate(cols):
-                nums[j, i, s.nk :] = -b[blk] / a0[j]
-        return nums
+        return self._monic()[1]
 
     @property
     def intercept(self) -> np.ndarray:
@@ -221,22 +206,7 @@ class LinearModel:
     # ----------------------------------------------------------------- time domain
     def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
         """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
-        nums = self.numerators
-        n_lag = nums.shape[2] - 1
-        if u_init is None:
-            u_ext = np.vstack([np.zeros((n_lag, self.n_inputs)), u])
-        else:
-            u0, _ = _as_2d(u_init, self.n_inputs, "u_init")
-            if u0.shape[0] < n_lag:
-                raise ValueError(f"u_init must hold the last {n_lag} inputs before u[0].")
-            u_ext = np.vstack([u0[u0.shape[0] - n_lag :], u])
-        x = np.empty((u.shape[0], self.n_outputs))
-        for j in range(self.n_outputs):
-            acc = np.zeros(u_ext.shape[0])
-            for i in range(self.n_inputs):
-                acc += signal.lfilter(nums[j, i], [1.0], u_ext[:, i])
-            x[:, j] = acc[n_lag:]
-        return x
+        return simulation.forced(self, u, u_init)
 
     def simulate(
         self,
@@ -264,28 +234,9 @@ class LinearModel:
         -------
         ndarray, shape (T,) for a SISO model given 1-D ``u``, else (T, n_outputs)
         """
-        u2, was_1d = _as_2d(u, self.n_inputs, "u")
-        x = self._forced(u2, u_init)
-        if include_offset:
-            x = x + self.intercept[None, :]
-        dens = self.denominators
-        na = self.structure.na
-        y0 = None
-        if y_init is not None:
-            y0, _ = _as_2d(y_init, self.n_outputs, "y_init")
-            if y0.shape[0] < na:
-                raise ValueError(f"y_init must hold the last {na} outputs before u[0].")
-            y0 = y0[y0.shape[0] - na :]
-        y = np.empty_like(x)
-        for j in range(self.n_outputs):
-            zi = None
-            if y0 is not None:
-                zi = signal.lfiltic([1.0], dens[j], y0[::-1, j])
-            if zi is None:
-                y[:, j] = signal.lfilter([1.0], dens[j], x[:, j])
-            else:
-                y[:, j] = signal.lfilter([1.0], dens[j], x[:, j], zi=zi)[0]
-        return y[:, 0] if (was_1d and self.n_outputs == 1) else y
+        return simulation.simulate(
+            self, u, y_init=y_init, u_init=u_init, include_offset=include_offset
+        )
 
     def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
@@ -307,31 +258,7 @@ class LinearModel:
         -------
         ndarray, same shape as ``y``
         """
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
-        u2, _ = _as_2d(u, self.n_inputs, "u")
-        y2, y_1d = _as_2d(y, self.n_outputs, "y")
-        if u2.shape[0] != y2.shape[0]:
-            raise ValueError(
-                f"u and y must have the same length; got len(u)={u2.shape[0]}, "
-                f"len(y)={y2.shape[0]}."
-            )
-        start = self.structure.max_lag
-        x = self._forced(u2, None) + self.intercept[None, :]
-        dens = self.denominators
-        na = self.structure.na
-        n = y2.shape[0]
-        preds = [y2]  # preds[j]: prediction of y(n) from outputs measured up to n - j
-        for step in range(1, k + 1):
-            acc = x[start:].copy()
-            for lag in range(1, na + 1):
-                src = preds[max(step - lag, 0)]
-                acc -= dens[:, lag][None, :] * src[start - lag : n - lag]
-            cur = y2.copy()
-            cur[start:] = acc
-            preds.append(cur)
-        out = preds[k]
-        return out[:, 0] if (y_1d and self.n_outputs == 1) else out
+        return simulation.predict(self, u, y, k)
 
     def infer_input(
         self, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
@@ -356,38 +283,8 @@ class LinearModel:
             ``u_hat[m]`` estimates ``u[m]`` for ``m = 0 .. T-nk-1`` (zero initial state of
             the inverse filter).
         """
-        self._siso("infer_input")
-        y2, _ = _as_2d(y, 1, "y")
-        yv = y2[:, 0]
-        s = self.structure
-        num = self.num[s.nk :]
-        if abs(num[0]) <= 1e-9 * max(np.max(np.abs(num)), 1e-300):
-            raise ModelError(
-                f"b0 is about 0 (numerator {num.round(9).tolist()}): the current input does "
-                "not reach the output after nk samples; increase nk by one and refit."
-            )
-        zeros = np.roots(num) if num.size > 1 else np.array([])
-        if zeros.size and np.max(np.abs(zeros)) >= 1.0 and not allow_unstable:
-            raise ModelError(
-                f"the inverse model is unstable: B(z) has zeros {np.round(zeros, 4).tolist()} "
-                "on or outside the unit circle (a non-minimum-phase model). Pass "
-                "allow_unstable=True to compute it anyway."
-            )
-        if y_init is None:
-            past = np.full(s.na, yv[0])
-        else:
-            past = np.asarray(y_init, dtype=np.float64).ravel()
-            if past.size < s.na:
-                raise ValueError(
-                    f"y_init must hold the last {s.na} outputs before y[0]; got {past.size}."
-                )
-            past = past[past.size - s.na :]
-        y_ext = np.concatenate([past, yv])
-        w = signal.lfilter(self.den, [1.0], y_ext)[s.na :] - self.intercept[0]
-        u_hat = signal.lfilter([1.0], num, w)
-        return u_hat[s.nk :] if s.nk else u_hat
+        return simulation.infer_input(self, y, y_init=y_init, allow_unstable=allow_unstable)
 
-    # ----------------------------------------------------------------- export
     def _padded(self, output: int, input: int) -> tuple[np.ndarray, np.ndarray]:
         """Numerator and denominator in descending powers of ``z`` (equal length)."""
         num = self.numerators[output, input]

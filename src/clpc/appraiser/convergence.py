@@ -1,0 +1,182 @@
+"""When a CLPC trace became quasi-constant, and the model it settles on.
+
+:meth:`clpc.Trace.convergence` and :meth:`clpc.Trace.steady_state_model` call these
+functions (``trace`` is a :class:`clpc.Trace`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from clpc.model import LinearModel
+
+__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model"]
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """When the appraiser's outputs became quasi-constant.
+
+    Attributes
+    ----------
+    converged : bool
+        Whether ``consecutive`` accepted updates in a row changed less than the tolerances.
+    update : int
+        Row of the trace where the quasi-constant phase starts (-1 if never).
+    index : int
+        Sample index of that update (-1 if never).
+    time : float
+        Its time [s] (nan if never).
+    theta_tol, D_tol : float
+        Tolerances used: ``||theta_j - theta_{j-1}||`` (unit vectors) and
+        ``|D_j - D_{j-1}| / D_j``.
+    consecutive : int
+    theta_variation : float
+        After convergence: largest ``||theta_j - theta_ss||`` over accepted updates.
+    D_variation : float
+        After convergence: largest ``|D_j - mean D| / mean D``.
+    trusted_fraction : float
+        Share of the updates whose window is trusted (every equation); convergence is
+        never reported below :data:`MIN_TRUSTED_FRACTION`.
+    reason : str
+        In words: why the trace converged or did not.
+    """
+
+    converged: bool
+    update: int
+    index: int
+    time: float
+    theta_tol: float
+    D_tol: float
+    consecutive: int
+    theta_variation: float
+    D_variation: float
+    trusted_fraction: float = 1.0
+    reason: str = ""
+
+
+#: ``converged`` is never reported when fewer updates than this share come from trusted
+#: windows (most windows then say nothing reliable about the system).
+MIN_TRUSTED_FRACTION = 0.5
+
+
+def convergence(
+    trace: Any, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
+) -> Convergence:
+    """First update after which ``theta`` and ``D`` stay quasi-constant.
+
+    An update is quasi-constant when every equation's accepted ``theta`` moved by less
+    than ``theta_tol`` (Euclidean, unit vectors) and ``D`` by less than ``D_tol``
+    (relative) since the previous update; convergence needs ``consecutive`` such
+    updates in a row.
+    """
+    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    theta = trace.arrays["theta"]
+    d: np.ndarray = trace.arrays["D"]
+    n = len(trace)
+    quiet: np.ndarray = np.zeros(n, dtype=bool)
+    if n > 1:
+        dtheta = np.linalg.norm(theta[1:] - theta[:-1], axis=2).max(axis=1)
+        scale = np.maximum(np.abs(d[1:]), np.finfo(float).tiny)
+        dd = (np.abs(d[1:] - d[:-1]) / scale).max(axis=1)
+        quiet[1:] = acc[1:] & acc[:-1] & (dtheta < theta_tol) & (dd < D_tol)
+    run = np.convolve(quiet.astype(int), np.ones(consecutive, dtype=int), "valid")
+    hits = np.flatnonzero(run == consecutive) if run.size else np.array([], int)
+    trusted = trace.arrays.get("trusted")
+    frac = float(trusted.all(axis=1).mean()) if trusted is not None and n else 1.0
+    none = (float("nan"), theta_tol, D_tol, consecutive, float("nan"), float("nan"))
+    if frac < MIN_TRUSTED_FRACTION:
+        why = (
+            f"not converged: only {frac:.0%} of the {n} windows are trusted (at least "
+            f"{MIN_TRUSTED_FRACTION:.0%} needed: enough rows, excited above quantization, "
+            "determined)"
+        )
+        return Convergence(False, -1, -1, *none, frac, why)
+    if hits.size == 0:
+        why = (
+            f"not converged: no {consecutive} accepted updates in a row moved theta by "
+            f"less than {theta_tol:g} and D by less than {D_tol:.0%}"
+        )
+        return Convergence(False, -1, -1, *none, frac, why)
+    start = int(hits[0])
+    after = acc & (np.arange(n) >= start)
+    ss = _mean_theta(theta[after])
+    th_var = float(np.linalg.norm(theta[after] - ss[None], axis=2).max())
+    d_mean = d[after].mean(axis=0)
+    d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
+    why = (
+        f"converged at update {start + 1}: {consecutive} accepted updates in a row moved "
+        f"theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; {frac:.0%} of "
+        "the windows are trusted"
+    )
+    return Convergence(
+        True,
+        start,
+        int(trace.index[start]),
+        float(trace.time[start]),
+        theta_tol,
+        D_tol,
+        consecutive,
+        th_var,
+        d_var,
+        frac,
+        why,
+    )
+
+
+def steady_state_model(
+    trace: Any, conv: Convergence | None = None, *, allow_unconverged: bool = False
+) -> LinearModel:
+    """The identified black box: the mean accepted ``theta`` of the quasi-constant phase.
+
+    Parameters
+    ----------
+    conv : Convergence, optional
+        Default: :func:`convergence` with its default tolerances.
+    allow_unconverged : bool
+        If the trace never converged, use the last accepted update instead of raising.
+
+    Returns
+    -------
+    LinearModel
+        With ``info["convergence"]``.
+    """
+    conv = conv or convergence(trace)
+    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    if conv.converged:
+        sel = acc & (np.arange(len(trace)) >= conv.update)
+    elif allow_unconverged and acc.any():
+        sel = np.zeros(len(trace), dtype=bool)
+        sel[np.flatnonzero(acc)[-1]] = True
+    else:
+        raise ValueError(
+            "the trace never became quasi-constant (no steady state): "
+            f"{int(acc.sum())} of {len(trace)} updates were accepted; {conv.reason}. Use "
+            "a longer record, a richer input, larger tolerances, or allow_unconverged=True."
+        )
+    theta = _mean_theta(trace.arrays["theta"][sel])
+    c = trace.arrays["c"][sel].mean(axis=0)
+    return LinearModel(
+        theta=theta,
+        structure=trace.structure,
+        n_inputs=trace.n_inputs,
+        mode=trace.mode,
+        c=c,
+        dt=trace.sample_time,
+        input_names=trace.input_names,
+        output_names=trace.output_names,
+        info={
+            "convergence": conv,
+            "method": "clpc-steady-state",
+            "updates_used": int(sel.sum()),
+        },
+    )
+
+
+def _mean_theta(theta: np.ndarray) -> np.ndarray:
+    """Mean of unit vectors (a0 > 0 already), renormalised: shape (E, p)."""
+    mean = theta.mean(axis=0)
+    return mean / np.linalg.norm(mean, axis=1, keepdims=True)

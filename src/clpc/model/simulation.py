@@ -1,0 +1,136 @@
+"""Running a :class:`clpc.LinearModel` on data: free run, k-step prediction, input inference.
+
+The model's methods of the same names call these functions (``model`` is a
+:class:`clpc.LinearModel`; typed loosely here so that this module need not import it).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from clpc.model.errors import ModelError, as_2d
+
+__all__ = ["forced", "infer_input", "predict", "simulate"]
+
+
+def forced(model: Any, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
+    """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
+    nums = model.numerators
+    n_lag = nums.shape[2] - 1
+    if u_init is None:
+        u_ext = np.vstack([np.zeros((n_lag, model.n_inputs)), u])
+    else:
+        u0, _ = as_2d(u_init, model.n_inputs, "u_init")
+        if u0.shape[0] < n_lag:
+            raise ValueError(f"u_init must hold the last {n_lag} inputs before u[0].")
+        u_ext = np.vstack([u0[u0.shape[0] - n_lag :], u])
+    x = np.empty((u.shape[0], model.n_outputs))
+    for j in range(model.n_outputs):
+        acc = np.zeros(u_ext.shape[0])
+        for i in range(model.n_inputs):
+            acc += signal.lfilter(nums[j, i], [1.0], u_ext[:, i])
+        x[:, j] = acc[n_lag:]
+    return x
+
+
+def simulate(
+    model: Any,
+    u: Any,
+    *,
+    y_init: Any | None = None,
+    u_init: Any | None = None,
+    include_offset: bool = True,
+) -> np.ndarray:
+    """Free-run simulation from the input alone (see :meth:`clpc.LinearModel.simulate`)."""
+    u2, was_1d = as_2d(u, model.n_inputs, "u")
+    x = forced(model, u2, u_init)
+    if include_offset:
+        x = x + model.intercept[None, :]
+    dens = model.denominators
+    na = model.structure.na
+    y0 = None
+    if y_init is not None:
+        y0, _ = as_2d(y_init, model.n_outputs, "y_init")
+        if y0.shape[0] < na:
+            raise ValueError(f"y_init must hold the last {na} outputs before u[0].")
+        y0 = y0[y0.shape[0] - na :]
+    y = np.empty_like(x)
+    for j in range(model.n_outputs):
+        zi = None
+        if y0 is not None:
+            zi = signal.lfiltic([1.0], dens[j], y0[::-1, j])
+        if zi is None:
+            y[:, j] = signal.lfilter([1.0], dens[j], x[:, j])
+        else:
+            y[:, j] = signal.lfilter([1.0], dens[j], x[:, j], zi=zi)[0]
+    return y[:, 0] if (was_1d and model.n_outputs == 1) else y
+
+
+def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
+    """``k``-step-ahead prediction ``y_hat(n | n-k)`` (:meth:`clpc.LinearModel.predict`)."""
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
+    u2, _ = as_2d(u, model.n_inputs, "u")
+    y2, y_1d = as_2d(y, model.n_outputs, "y")
+    if u2.shape[0] != y2.shape[0]:
+        raise ValueError(
+            f"u and y must have the same length; got len(u)={u2.shape[0]}, len(y)={y2.shape[0]}."
+        )
+    start = model.structure.max_lag
+    x = forced(model, u2, None) + model.intercept[None, :]
+    dens = model.denominators
+    na = model.structure.na
+    n = y2.shape[0]
+    preds = [y2]  # preds[j]: prediction of y(n) from outputs measured up to n - j
+    for step in range(1, k + 1):
+        acc = x[start:].copy()
+        for lag in range(1, na + 1):
+            src = preds[max(step - lag, 0)]
+            acc -= dens[:, lag][None, :] * src[start - lag : n - lag]
+        cur = y2.copy()
+        cur[start:] = acc
+        preds.append(cur)
+    out = preds[k]
+    return out[:, 0] if (y_1d and model.n_outputs == 1) else out
+
+
+def infer_input(
+    model: Any, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
+) -> np.ndarray:
+    """The input that explains a measured output (:meth:`clpc.LinearModel.infer_input`)."""
+    model._siso("infer_input")
+    y2, _ = as_2d(y, 1, "y")
+    yv = y2[:, 0]
+    s = model.structure
+    num = model.num[s.nk :]
+    if abs(num[0]) <= 1e-9 * max(np.max(np.abs(num)), 1e-300):
+        raise ModelError(
+            f"b0 is about 0 (numerator {num.round(9).tolist()}): the current input does "
+            "not reach the output after nk samples; increase nk by one and refit."
+        )
+    zeros = np.roots(num) if num.size > 1 else np.array([])
+    if zeros.size and np.max(np.abs(zeros)) >= 1.0 and not allow_unstable:
+        raise ModelError(
+            f"the inverse model is unstable: B(z) has zeros {np.round(zeros, 4).tolist()} "
+            "on or outside the unit circle (a non-minimum-phase model). Pass "
+            "allow_unstable=True to compute it anyway."
+        )
+    if y_init is None:
+        past = np.full(s.na, yv[0])
+    else:
+        past = np.asarray(y_init, dtype=np.float64).ravel()
+        if past.size < s.na:
+            raise ValueError(
+                f"y_init must hold the last {s.na} outputs before y[0]; got {past.size}."
+            )
+        past = past[past.size - s.na :]
+    y_ext = np.concatenate([past, yv])
+    w = signal.lfilter(model.den, [1.0], y_ext)[s.na :] - model.intercept[0]
+    u_hat = signal.lfilter([1.0], num, w)
+    return u_hat[s.nk :] if s.nk else u_hat
+
+
+# ----------------------------------------------------------------- export
