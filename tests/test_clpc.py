@@ -347,7 +347,7 @@ def test_to_frame_columns():
         ({"window_size": 0}, "window_size must be an int"),
         ({"cluster_size": 0}, "cluster_size must be an int"),
         ({"cluster_size": 2.5}, "cluster_size must be an int"),
-        ({"sample_time": -1.0}, "sample_time must be a positive"),
+        ({"sample_time": -1.0}, "sample_time must be > 0"),
         ({"method": "lsq"}, "method must be"),
         ({"min_rows": 1}, "min_rows must be an int"),
     ],

@@ -11,12 +11,20 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["check_bool", "check_choice", "check_int", "check_nonnegative", "check_positive"]
+__all__ = [
+    "REAL",
+    "check_bool",
+    "check_choice",
+    "check_int",
+    "check_nonnegative",
+    "check_positive",
+    "check_real",
+]
 
 
 def check_int(value: Any, name: str, low: int = 0, high: int | None = None) -> int:
     """``value`` as an int in ``[low, high]``; ``ValueError`` naming ``name`` otherwise."""
-    span = f"[{low}, {'inf' if high is None else high}]"
+    span = f"[{low}, inf)" if high is None else f"[{low}, {high}]"
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         raise ValueError(f"{name} must be an int in the range {span}; got {value!r}.")
     if value < low or (high is not None and value > high):
@@ -24,34 +32,40 @@ def check_int(value: Any, name: str, low: int = 0, high: int | None = None) -> i
     return int(value)
 
 
-def _number(value: Any, name: str, what: str) -> float:
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise ValueError(f"{name} must be {what}; got {value!r}.")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {what}; got {value!r}.") from None
+#: Types accepted as real scalars (``bool`` is refused separately).
+REAL = (int, float, np.integer, np.floating)
+
+
+def check_real(value: Any, name: str, unit: str = "") -> float:
+    """``value`` as a finite float; booleans, strings and other objects are refused."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, REAL):
+        raise ValueError(f"{name} must be a real number{_unit(unit)}; got {value!r}. Pass a float.")
+    v = float(value)
     if not math.isfinite(v):
-        raise ValueError(f"{name} must be {what}; got {value!r}.")
+        raise ValueError(f"{name} must be finite; got {value!r}. Pass a finite float.")
     return v
 
 
 def check_positive(value: Any, name: str, unit: str = "") -> float:
     """``value`` as a finite float > 0 (``unit`` names it in the message, e.g. ``"s"``)."""
-    what = "a positive finite number" + (f" [{unit}]" if unit else "")
-    v = _number(value, name, what)
+    v = check_real(value, name, unit)
     if v <= 0:
-        raise ValueError(f"{name} must be {what}; got {value!r}.")
+        raise ValueError(f"{name} must be > 0{_unit(unit)}; got {value!r}. Pass a positive value.")
     return v
 
 
 def check_nonnegative(value: Any, name: str, unit: str = "") -> float:
     """``value`` as a finite float >= 0."""
-    what = "a finite number >= 0" + (f" [{unit}]" if unit else "")
-    v = _number(value, name, what)
+    v = check_real(value, name, unit)
     if v < 0:
-        raise ValueError(f"{name} must be {what}; got {value!r}.")
+        raise ValueError(
+            f"{name} must be >= 0{_unit(unit)}; got {value!r}. Pass zero or a positive value."
+        )
     return v
+
+
+def _unit(unit: str) -> str:
+    return f" [{unit}]" if unit else ""
 
 
 def check_bool(value: Any, name: str) -> bool:

@@ -12,21 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-
+from clpc.core.checks import check_int
 from clpc.data import DataError
 
 __all__ = ["MimoMode", "Structure", "check_mode", "column_labels", "default_mode"]
 
 MimoMode = Literal["siso", "paired", "miso"]
-
-
-def _check_int(value: object, name: str, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} must be an int in the range [{low}, inf); got {value!r}.")
-    if value < low:
-        raise ValueError(f"{name} must be an int in the range [{low}, inf); got {value}.")
-    return int(value)
 
 
 @dataclass(frozen=True)
@@ -48,14 +39,14 @@ class Structure:
     nk: int = 0
 
     def __post_init__(self) -> None:
-        _check_int(self.na, "na", 1)
-        _check_int(self.nb, "nb", 0)
-        _check_int(self.nk, "nk", 0)
+        check_int(self.na, "na", 1)
+        check_int(self.nb, "nb", 0)
+        check_int(self.nk, "nk", 0)
 
     @classmethod
     def from_order(cls, order: int, nk: int = 0) -> Structure:
         """The paper's structure: ``na = nb = order``."""
-        order = _check_int(order, "order", 1)
+        order = check_int(order, "order", 1)
         return cls(order, order, nk)
 
     @classmethod

@@ -21,10 +21,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from clpc.core.checks import check_int
+from clpc.core.checks import check_nonnegative as nonnegative
+from clpc.core.checks import check_positive as positive
+from clpc.core.checks import check_real as real
 from clpc.plants.excitation import chirp, multisine, prbs
 from clpc.plants.grid import EPS, first_index, sample_grid, time_grid
 from clpc.plants.moves import MoveCycle, fill_moves
-from clpc.plants.validation import nonnegative, positive, real
 
 __all__ = [
     "chirp",

@@ -18,8 +18,10 @@ from typing import Literal
 import numpy as np
 
 from clpc.core.checks import check_choice, check_int
+from clpc.core.checks import check_nonnegative as nonnegative
+from clpc.core.checks import check_positive as positive
+from clpc.core.checks import check_real as real
 from clpc.plants.grid import sample_grid
-from clpc.plants.validation import nonnegative, positive, real
 
 __all__ = ["chirp", "multisine", "prbs"]
 

@@ -108,13 +108,13 @@ from typing import Any, Literal
 
 import numpy as np
 
+from clpc.core.checks import check_real as real
 from clpc.plants.servo_inputs import _check_params, _check_rates, _check_signal, _streams
 from clpc.plants.servo_layout import _O_TAU, _O_VCMD
 from clpc.plants.servo_loop import numba_available
 from clpc.plants.servo_parameters import ServoParameters
 from clpc.plants.servo_records import MotorRecord, ServoRecord, _readonly, _shaft_log
 from clpc.plants.servo_run import RunSetup, _run
-from clpc.plants.validation import real
 
 __all__ = [
     "MotorRecord",

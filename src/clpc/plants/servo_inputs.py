@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.checks import REAL
 from clpc.plants.servo_parameters import ServoParameters
-from clpc.plants.validation import REAL
 
 __all__: list[str] = []
 

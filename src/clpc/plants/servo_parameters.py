@@ -9,7 +9,10 @@ from typing import Any
 
 import numpy as np
 
-from clpc.plants.validation import REAL, nonnegative, positive, real
+from clpc.core.checks import REAL
+from clpc.core.checks import check_nonnegative as nonnegative
+from clpc.core.checks import check_positive as positive
+from clpc.core.checks import check_real as real
 
 __all__ = ["ServoParameters"]
 
