@@ -17,6 +17,10 @@ __all__ = ["SampleBuffer"]
 class SampleBuffer:
     """Decimated samples from absolute index ``start`` on.
 
+    The samples live in a store with spare rows at the end: appending copies the new rows
+    into it and forgetting old ones moves a pointer, so an update costs no reallocation
+    (the live rows are moved to the front only when the spare rows run out).
+
     Parameters
     ----------
     n_columns : int
@@ -24,21 +28,38 @@ class SampleBuffer:
     """
 
     def __init__(self, n_columns: int) -> None:
-        self.data = np.empty((0, n_columns))
+        self._store = np.empty((0, n_columns))
+        self._lo = 0  # live rows are _store[_lo:_hi]
+        self._hi = 0
         self.start = 0
         self.pending: list[Any] = []  # samples kept aside by step(): arrays or (u, y)
+
+    @property
+    def data(self) -> np.ndarray:
+        """The live samples (a C-contiguous view), shape (n, channels)."""
+        return self._store[self._lo : self._hi]
+
+    @data.setter
+    def data(self, values: np.ndarray) -> None:
+        self._store = np.array(values, dtype=np.float64, order="C")
+        self._lo, self._hi = 0, self._store.shape[0]
 
     def flush(self) -> None:
         """Move the samples kept aside into ``data``."""
         if self.pending:
-            block = np.array(self.pending, dtype=np.float64).reshape(len(self.pending), -1)
-            self.pending = []
-            self.append(block)
+            self.append(self.take_pending())
 
     def append(self, new: np.ndarray) -> None:
         """Append decimated samples (after the pending ones)."""
         self.flush()
-        self.data = np.vstack([self.data, new]) if self.data.size else new.copy()
+        n = new.shape[0]
+        if self._hi + n > self._store.shape[0]:
+            live = self._hi - self._lo
+            store = np.empty((2 * (live + n), new.shape[1]))
+            store[:live] = self._store[self._lo : self._hi]
+            self._store, self._lo, self._hi = store, 0, live
+        self._store[self._hi : self._hi + n] = new
+        self._hi += n
 
     def take_pending(self) -> np.ndarray:
         """The samples kept aside, as an array, removed from ``pending``."""
@@ -50,7 +71,7 @@ class SampleBuffer:
         """Forget samples older than absolute index ``sample``."""
         drop = sample - self.start
         if drop > 0:
-            self.data = self.data[drop:].copy()
+            self._lo = min(self._lo + drop, self._hi)
             self.start = sample
 
     def since(self, sample: int) -> np.ndarray:
