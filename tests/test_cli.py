@@ -134,7 +134,7 @@ def test_identify_auto_order(record):
     assert s["order_selection"]["criterion"] == "validation"
     assert s["dt"] == pytest.approx(0.01)
     out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto").output
-    assert "order selection (held-out 10-step fit %" in out
+    assert "order selection (held-out score: mean of free-run and" in out
     out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto", "--criterion", "bic").output
     assert "order selection (BIC, lower is better)" in out
 

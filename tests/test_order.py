@@ -178,3 +178,38 @@ def test_select_delay_finds_the_dead_time():
     assert sel.validation_fit[3] > sel.validation_fit[0] + 10.0
     with pytest.raises(ValueError, match="delays must be ints >= 0"):
         clpc.select_delay(u, y, delays=[-1])
+
+
+# ---------------------------------------------------------------- held-out validation
+def test_validation_is_the_default_and_rejects_unstable_candidates():
+    from clpc import datasets
+
+    data = datasets.load("ballbeam")
+    sel = select_order(data, orders=range(1, 6))
+    assert sel.criterion == "validation"
+    assert len(sel.stability) == 5 and "unstable" in sel.stability  # orders 2.. diverge
+    assert sel.stability[list(sel.orders).index(sel.best)] != "unstable"
+    assert "rejected" in sel.reason and f"order {sel.best}" in sel.reason
+    assert np.all(np.isfinite(sel.free_run_fit[np.array(sel.stability) == "stable"]))
+
+
+def test_horizon_is_one_dominant_time_constant(rich_input):
+    from clpc.lpc.heldout import horizon
+
+    u = rich_input(3000, seed=41)
+    slow = select_order(u, signal.lfilter([0.0, 0.1], [1.0, -0.97], u), orders=[1, 2])
+    fast = select_order(u, signal.lfilter([0.0, 1.0], [1.0, -0.3], u), orders=[1, 2])
+    assert slow.horizon == round(-1 / np.log(0.97))  # 33 samples
+    assert fast.horizon == 2  # the shortest horizon
+    model = LPC(order=1).fit(u, signal.lfilter([0.0, 1.0], [1.0, -0.999], u))
+    assert horizon(model, 1000) == 100  # capped at a tenth of the held-out part
+
+
+def test_every_candidate_unstable_is_said(monkeypatch, rich_input):
+    from clpc.lpc import heldout
+
+    u = rich_input(2000, seed=42)
+    y = signal.lfilter([0.0, 1.0], [1.0, -0.5], u)
+    monkeypatch.setattr(heldout, "stability", lambda model: "unstable")
+    sel = select_order(u, y, orders=[1, 2, 3])
+    assert "every candidate is unstable" in sel.reason and sel.best in (1, 2, 3)

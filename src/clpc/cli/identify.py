@@ -28,13 +28,18 @@ __all__ = ["identify"]
 def _selection_line(result: IdentifyResult) -> str:
     """The order selection table on one line."""
     assert result.selection is not None
+    sel = result.selection
     if result.criterion == "validation":
-        what = "held-out 10-step fit %, higher is better"
+        what = f"held-out score: mean of free-run and {sel.horizon}-step fit %, higher is better"
     else:
         what = f"{result.criterion.upper()}, lower is better"
-    orders, scores = result.selection.orders, result.scores()
-    table = ", ".join(f"N={o}: {v:.1f}" for o, v in zip(orders, scores, strict=True))
-    return f"order selection ({what}): {table} -> N={result.selection.best}"
+    marks = [f" ({s})" if s == "unstable" else "" for s in sel.stability] or [""] * len(sel.orders)
+    scores = result.scores()
+    table = ", ".join(
+        f"N={o}: {v:.1f}{m}" for o, v, m in zip(sel.orders, scores, marks, strict=True)
+    )
+    line = f"order selection ({what}): {table} -> N={sel.best}"
+    return f"{line}\n  {sel.reason}" if sel.reason else line
 
 
 @click.command(cls=ClpcCommand)
@@ -61,8 +66,9 @@ def _selection_line(result: IdentifyResult) -> str:
     type=click.Choice(["validation", "bic", "aic", "remark1"]),
     default="validation",
     show_default=True,
-    help="How --order auto chooses: held-out 10-step prediction fit on the last third "
-    "(validation), BIC, AIC or the paper's Remark 1.",
+    help="How --order auto chooses: on the last third held out, the mean of the free-run "
+    "and the k-step prediction fit (k: one dominant time constant), unstable orders "
+    "rejected (validation); BIC, AIC or the paper's Remark 1.",
 )
 @nk_option()
 @method_option()

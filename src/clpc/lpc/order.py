@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from clpc.data import as_iodata
+from clpc.lpc import heldout
 from clpc.lpc.estimator import LPC
 
 __all__ = ["DelaySelection", "OrderSelection", "select_delay", "select_order"]
@@ -31,6 +32,15 @@ class OrderSelection:
     best : int
         The chosen order.
     criterion : str
+    validation_fit, free_run_fit, kstep_fit : ndarray, shape (n,), optional
+        ``"validation"``: the score (mean of the free-run and the ``horizon``-step fit %
+        on the held-out part) and its two parts, per order.
+    stability : tuple of str
+        ``"validation"``: ``"stable"``, ``"integrating"`` or ``"unstable"`` per order.
+    horizon : int, optional
+        The prediction horizon [samples] the validation used.
+    reason : str
+        Why ``best`` was chosen, in words.
     """
 
     orders: np.ndarray
@@ -43,6 +53,11 @@ class OrderSelection:
     best: int
     criterion: str
     validation_fit: np.ndarray | None = None
+    free_run_fit: np.ndarray | None = None
+    kstep_fit: np.ndarray | None = None
+    stability: tuple[str, ...] = ()
+    horizon: int | None = None
+    reason: str = ""
 
     def to_frame(self) -> Any:
         """The table as a pandas DataFrame (needs pandas)."""
@@ -66,11 +81,11 @@ def select_order(
     y: Any | None = None,
     *,
     orders: Any = range(1, 7),
-    criterion: str = "bic",
+    criterion: str = "validation",
     min_improvement: float = 0.1,
     estimator: LPC | None = None,
     dt: float | None = None,
-    k: int = 10,
+    k: int | None = None,
     validation_fraction: float = 1.0 / 3.0,
     parsimony: float = 1.0,
 ) -> OrderSelection:
@@ -86,16 +101,19 @@ def select_order(
         ``"remark1"``: the paper's rule - from the lowest order, raise ``N`` while the
         noise variance (hence ``J``) falls by at least ``min_improvement`` (relative);
         ``"aic"``/``"bic"``: the minimum of the information criterion;
-        ``"validation"``: fit on the first ``1 - validation_fraction`` of the record and
-        take the order with the best ``k``-step-ahead prediction fit % on the rest (the
-        criterion that works on real data, where the likelihood keeps rising with the
-        order).
+        ``"validation"`` (default, as in the command line): fit on the first
+        ``1 - validation_fraction`` of the record and score each order on the rest by the
+        mean of its free-run fit % and its ``k``-step-ahead prediction fit %
+        (:mod:`clpc.lpc.heldout`); unstable candidates are never chosen while a stable or
+        integrating one exists (the criterion that works on real data, where the
+        likelihood keeps rising with the order).
     min_improvement : float
         Relative decrease of ``sigma_r^2`` that counts as meaningful for ``"remark1"``.
     estimator : LPC, optional
         Settings (method, weighting, delay); its order is replaced.
-    k : int
-        Prediction horizon for ``"validation"``.
+    k : int, optional
+        Prediction horizon [samples] for ``"validation"``; default: one dominant time
+        constant of the lowest order's model (:func:`clpc.lpc.heldout.horizon`).
     validation_fraction : float
         Share of the record held out for ``"validation"`` (0 < f < 1).
     parsimony : float
@@ -140,11 +158,10 @@ def select_order(
         )
     cols = [np.array(col) for col in zip(*rows, strict=True)]
     J, ll, aic, bic, var, n_par = cols
-    val_fit = None
+    table = OrderSelection(orders, J, ll, aic, bic, var, n_par.astype(int), 0, criterion)
     if criterion == "validation":
-        val_fit = _validation_fits(data, base, orders, k, validation_fraction)
-        best = int(orders[np.flatnonzero(val_fit >= val_fit.max() - parsimony)[0]])
-    elif criterion == "aic":
+        return _by_validation(table, data, base, (k, validation_fraction, parsimony))
+    if criterion == "aic":
         best = int(orders[np.argmin(aic)])
     elif criterion == "bic":
         best = int(orders[np.argmin(bic)])
@@ -155,25 +172,51 @@ def select_order(
                 best = int(orders[i])
             else:
                 break
-    return OrderSelection(orders, J, ll, aic, bic, var, n_par.astype(int), best, criterion, val_fit)
+    return replace(table, best=best, reason=f"the {criterion} criterion")
 
 
-def _validation_fits(
-    data: Any, base: LPC, orders: np.ndarray, k: int, fraction: float
-) -> np.ndarray:
-    """``k``-step-ahead fit % on the held-out tail, per order (summed over outputs' errors)."""
+def _by_validation(
+    table: OrderSelection, data: Any, base: LPC, opts: tuple[int | None, float, float]
+) -> OrderSelection:
+    """The order chosen on held-out data (see :func:`select_order`)."""
+    k, fraction, parsimony = opts
     split = round(data.n_samples * (1.0 - fraction))
-    est, val = data[:split], data[split:]
-    fits = []
-    for order in orders:
-        model = replace(base, order=int(order), na=None, nb=None).fit(est)
-        y_hat = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
-        start = model.structure.max_lag
-        err = np.linalg.norm(val.y[start:] - y_hat[start:])
-        ref = np.linalg.norm(val.y[start:] - val.y[start:].mean(axis=0))
-        ok = np.isfinite(err) and ref > 0
-        fits.append(100.0 * (1.0 - err / ref) if ok else -np.inf)
-    return np.array(fits)
+    models = [
+        replace(base, order=int(order), na=None, nb=None).fit(data[:split])
+        for order in table.orders
+    ]
+    k = k if k is not None else heldout.horizon(models[0], data.n_samples - split)
+    scores = [heldout.score(m, data, split, k) for m in models]
+    total = np.array([s.score for s in scores])
+    usable = np.array([s.stability in ("stable", "integrating") for s in scores])
+    usable &= np.isfinite(total)
+    pool = usable if usable.any() else np.isfinite(total)
+    if not pool.any():
+        pool = np.ones(total.size, dtype=bool)
+    top = total[pool].max()
+    best_i = int(np.flatnonzero(pool & (total >= top - parsimony))[0])
+    if usable.any():
+        rejected = [int(o) for o, ok in zip(table.orders, usable, strict=True) if not ok]
+        reason = (
+            f"order {table.orders[best_i]}: the lowest whose held-out score (mean of free-run "
+            f"and {k}-step fit %) is within {parsimony:g} points of the best stable one"
+            + (f"; unstable or diverging orders {rejected} were rejected" if rejected else "")
+        )
+    else:
+        reason = (
+            f"order {table.orders[best_i]}: every candidate is unstable or diverges on the "
+            "held-out data; this is the least bad, not a good model"
+        )
+    return replace(
+        table,
+        best=int(table.orders[best_i]),
+        validation_fit=total,
+        free_run_fit=np.array([s.free_run for s in scores]),
+        kstep_fit=np.array([s.kstep for s in scores]),
+        stability=tuple(s.stability for s in scores),
+        horizon=int(k),
+        reason=reason,
+    )
 
 
 @dataclass(frozen=True)

@@ -146,7 +146,12 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
                 "orders": selection.orders,
                 "bic": selection.bic,
                 "validation_fit": selection.validation_fit,
+                "free_run_fit": selection.free_run_fit,
+                "kstep_fit": selection.kstep_fit,
+                "stability": list(selection.stability),
+                "horizon": selection.horizon,
                 "best": selection.best,
+                "reason": selection.reason,
             }
         )
     if settings.save:
