@@ -21,7 +21,8 @@ def eiv(seed, n=50_000, su=0.3, sy=0.1):
 def test_noise_variances_recovered_and_make_weighted_lpc_consistent(seed):
     u, y, scale = eiv(seed)
     est = estimate_noise_variances(u, y, order=2)
-    assert est.converged
+    assert est.converged and est.reliable and not est.clamped
+    assert est.order_agreement < 1.1 and "agrees" in est.reason
     assert est.output_variance == pytest.approx(0.01, rel=0.1)
     assert est.input_variance == pytest.approx(0.09, rel=0.1)
     weighted = clpc.LPC(order=2, noise_ratio=est.ratio).fit(u, y)
@@ -37,3 +38,15 @@ def test_noise_estimate_validation():
         estimate_noise_variances(np.ones(100), np.arange(100.0), extra_lags=0)
     with pytest.raises(DataError, match="one input and one output"):
         estimate_noise_variances(np.ones((100, 2)), np.arange(100.0))
+
+
+def test_unreliable_estimates_say_why():
+    # the dryer record at N = 2: the equations ask for a negative input variance (clamped),
+    # and the ratio moves by orders of magnitude at N = 3: not a white-noise EIV record
+    from clpc import datasets
+
+    data = datasets.load("dryer")
+    est = estimate_noise_variances(data, order=2)
+    assert est.clamped and not est.reliable
+    assert est.order_agreement > 1e3
+    assert "floor" in est.reason and "factor" in est.reason
