@@ -596,3 +596,27 @@ def test_constructor_only_stores(noisy_siso):
 
 def test_exports():
     assert clpc.lpc_solve is lpc_solve
+
+
+def test_default_is_consistent_under_eiv_with_unequal_channel_spreads():
+    # equal white noise (std 0.3) on u (std 1) and on y (std 4.3): per-channel scaling
+    # would assume equal signal-to-noise ratios and stay biased; the raw-unit default is TLS
+    true = np.array([-1.5, 0.7, 0.0, 1.0, 0.5])
+
+    def errors(n, seed):
+        rng = np.random.default_rng(seed)
+        u0 = rng.standard_normal(n)
+        y0 = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u0)
+        u, y = u0 + 0.3 * rng.standard_normal(n), y0 + 0.3 * rng.standard_normal(n)
+        out = []
+        for est in (LPC(order=2), LPC(order=2, scaling="std"), ARX(order=2)):
+            m = est.fit(u, y)
+            out.append(np.linalg.norm(np.r_[m.den[1:], m.num] - true))
+        return np.array(out)
+
+    short = np.mean([errors(10_000, s) for s in range(3)], axis=0)
+    long = np.mean([errors(100_000, s) for s in range(3)], axis=0)
+    lpc, std, ls = long
+    assert long[0] < 0.45 * short[0]  # falls like 1/sqrt(T) (0.32 for 10x the samples)
+    assert lpc < ls / 10  # a tenth of least squares' error at T = 1e5
+    assert std > 0.08 and ls > 0.08  # both biased: they do not fall with T

@@ -152,6 +152,8 @@ def model_summary(
         "structure": {"na": s.na, "nb": s.nb, "nk": s.nk},
         "mode": model.mode,
         "method": info.get("method"),
+        "scaling": info.get("scaling"),
+        "cancelled": info.get("cancelled", 0),
         "stable": model.is_stable,
         "equations": equations,
     }

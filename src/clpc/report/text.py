@@ -40,7 +40,12 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
     st = summary["structure"]
     lines = [
         f"LPC model  na={st['na']} nb={st['nb']} nk={st['nk']}  method={summary['method']}  "
-        f"mode={summary['mode']}  dt={summary['dt']:g} s",
+        f"scaling={summary.get('scaling')}  mode={summary['mode']}  dt={summary['dt']:g} s"
+        + (
+            f"  ({summary['cancelled']} common pole/zero factor(s) cancelled)"
+            if summary.get("cancelled")
+            else ""
+        ),
         f"inputs: {', '.join(summary['inputs'])}   outputs: {', '.join(summary['outputs'])}"
         + (f"   samples: {summary['n_samples']}" if "n_samples" in summary else ""),
         "transfer functions G(z) = -B(z)/A(z), monic A, powers of z^-1:",
