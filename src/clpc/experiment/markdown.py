@@ -90,8 +90,10 @@ def setup_table(summary: dict[str, Any]) -> str:
 | parameter_size | 3 (N = 2) | {s["parameters_size"]} |
 | window_size | 201 samples (2 s) | {s["window_size"]} samples ({s["window_time"]:.1f} s) |
 | data_cluster_dimension | 12 samples | {s["cluster_size"]} samples |
-| LPC solution | eigenvector of the smallest eigenvalue | `method="{s["method"]}"`, every \
-computable estimate accepted (`guard=False`) |
+| LPC solution | eigenvector of the smallest eigenvalue | `method="{s["method"]}"`, \
+`scaling="{s.get("scaling", "none")}"` (the library's default: total least squares in the \
+data's units), every computable estimate accepted (`guard=False`: the paper's appraiser; the \
+library's default guard would accept only trusted windows) |
 | command | ramp with saturation (Fig. 5) | ramp 0 -> {ramp["level"]} rad from \
 {ramp["start"]} s to {ramp["start"] + ramp["ramp_time"]:.1f} s, then held; \
 {ramp["duration"]:.1f} s record |

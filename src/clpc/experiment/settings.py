@@ -124,6 +124,7 @@ def settings_record(
         "log_sample_time": LOG_SAMPLE_TIME,
         "method": method,
         "guard": GUARD,
+        "scaling": "none",
         "tolerances": [list(t) for t in TOLERANCES],
         "ramp": {"duration": ramp_duration, **asdict(RAMP)},
         "rich": {"duration": rich_duration, **asdict(RICH_MOVES), "dither": asdict(RICH_DITHER)},
