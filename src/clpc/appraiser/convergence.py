@@ -171,6 +171,8 @@ def steady_state_model(
         info={
             "convergence": conv,
             "method": "clpc-steady-state",
+            "scaling": trace.meta.get("scaling"),
+            "guard": trace.meta.get("guard"),
             "updates_used": int(sel.sum()),
         },
     )
