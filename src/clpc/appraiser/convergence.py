@@ -130,20 +130,7 @@ def convergence(
 def steady_state_model(
     trace: Any, conv: Convergence | None = None, *, allow_unconverged: bool = False
 ) -> LinearModel:
-    """The identified black box: the mean accepted ``theta`` of the quasi-constant phase.
-
-    Parameters
-    ----------
-    conv : Convergence, optional
-        Default: :func:`convergence` with its default tolerances.
-    allow_unconverged : bool
-        If the trace never converged, use the last accepted update instead of raising.
-
-    Returns
-    -------
-    LinearModel
-        With ``info["convergence"]``.
-    """
+    """The mean accepted ``theta`` after convergence (:meth:`clpc.Trace.steady_state_model`)."""
     conv = conv or convergence(trace)
     acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
     if conv.converged:
