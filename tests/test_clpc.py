@@ -485,3 +485,18 @@ def test_guard_settings_are_checked_and_saved(tmp_path):
     assert CLPC.from_state_dict(a.state_dict()).trust_rows == 30
     assert not CLPC.from_state_dict(a.state_dict()).guard
     assert CLPC(gate=False).guard is False  # the former name
+
+
+@pytest.mark.parametrize("name", ["dryer", "robot_arm", "ballbeam", "exchanger"])
+def test_default_guard_never_holds_an_untrusted_model_on_real_records(name):
+    from clpc import datasets
+
+    data = datasets.load(name)
+    trace = CLPC(3, 201, 12).run(data)
+    acc, trusted = trace.arrays["accepted"], trace.arrays["trusted"]
+    assert not (acc & ~trusted).any()
+    # every held parameter vector is one a trusted window produced
+    ok = trace.arrays["has_model"][:, 0]
+    est = trace.arrays["theta_estimate"][:, 0][trusted[:, 0]]
+    for row in trace.arrays["theta"][:, 0][ok]:
+        assert np.any(np.all(est == row, axis=1))
