@@ -12,11 +12,29 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser.buffer import SampleBuffer
+from clpc.appraiser import fsm
 from clpc.appraiser.decimation import Decimator
+from clpc.appraiser.state_schema import (
+    MAX_STATE_BYTES,
+    StateError,
+    checked_array,
+    field,
+    parse_json,
+    validate_counters,
+)
+from clpc.core.checks import check_positive
 from clpc.core.rules import RobustRule
 
-__all__ = ["FORMAT", "VERSION", "config_of", "load", "restore", "save", "snapshot"]
+__all__ = [
+    "FORMAT",
+    "VERSION",
+    "StateError",
+    "config_of",
+    "load",
+    "restore",
+    "save",
+    "snapshot",
+]
 
 FORMAT = "clpc-appraiser-state"
 VERSION = 1
@@ -24,10 +42,6 @@ VERSION = 1
 
 def _arr(x: np.ndarray | None) -> Any:
     return None if x is None else {"shape": list(x.shape), "data": x.ravel().tolist()}
-
-
-def _unarr(x: Any) -> np.ndarray | None:
-    return None if x is None else np.asarray(x["data"], float).reshape(x["shape"])
 
 
 def config_of(a: Any) -> dict[str, Any]:
@@ -83,36 +97,96 @@ def snapshot(a: Any) -> dict[str, Any]:
     }
 
 
-def restore(cls: Any, state: dict[str, Any]) -> Any:
-    """An appraiser of class ``cls`` that continues exactly where ``state`` left off."""
+def restore(cls: Any, state: Any) -> Any:
+    """An appraiser of class ``cls`` that continues exactly where ``state`` left off.
+
+    Every field is checked first (:mod:`clpc.appraiser.state_schema`); a damaged or edited
+    state raises :class:`~clpc.appraiser.state_schema.StateError` naming the field.
+    """
+    if not isinstance(state, dict):
+        raise StateError(f"a state must be a JSON object; got {type(state).__name__}.")
     if state.get("format") != FORMAT or state.get("version") != VERSION:
-        raise ValueError("not a clpc appraiser state (format/version mismatch).")
-    cfg = dict(state["config"])
-    size = cfg.pop("parameters_size")
+        raise StateError("not a clpc appraiser state (format/version mismatch).")
+    a = _configured(cls, field(state, "config", dict))
+    n_in, n_out = state.get("n_in"), state.get("n_out")
+    n_seen, j_done = field(state, "n_seen", int), field(state, "j_done", int)
+    if n_in is None or n_out is None:
+        if n_in is not None or n_out is not None or n_seen or j_done:
+            raise StateError("a state without channels (n_in, n_out) must have seen nothing.")
+        return a
+    n_in, n_out = field(state, "n_in", int), field(state, "n_out", int)
+    if n_in < 1 or n_out < 1:
+        raise StateError(f"n_in and n_out must be >= 1; got {n_in}, {n_out}.")
+    fsm.init_channels(a, n_in, n_out, _names(state.get("names"), n_in, n_out))
+    buf = checked_array(field(state, "buf", dict), "buf", (None, n_in + n_out))
+    start = field(state, "buf_start", int)
+    sizes = (a.structure.max_lag, a.window_size, a.cluster_size)
+    validate_counters((n_seen, j_done, start, buf.shape[0]), sizes)
+    assert a._buffer is not None
+    if buf.size:
+        a._buffer.data = buf
+    a._buffer.start = start
+    a._n_seen, a._j_done = n_seen, j_done
+    p = a._last_theta.shape[1]
+    a._last_theta = checked_array(state.get("last_theta"), "last_theta", (n_out, p))
+    a._last_c = checked_array(state.get("last_c"), "last_c", (n_out,))
+    hm = state.get("has_model")
+    if not isinstance(hm, list) or len(hm) != n_out or not all(isinstance(x, bool) for x in hm):
+        raise StateError(f"state['has_model'] must be {n_out} booleans; got {hm!r:.60}.")
+    a._has_model = np.asarray(hm, dtype=bool)
+    _restore_decimator(a, state, n_in + n_out)
+    record_dt = state.get("record_dt")
+    if record_dt is not None:
+        a._record_dt = check_positive(record_dt, "state['record_dt']", "s")
+    return a
+
+
+def _configured(cls: Any, config: dict[str, Any]) -> Any:
+    """A new appraiser from the saved constructor arguments (checked by the constructor)."""
+    cfg = dict(config)
+    size = cfg.pop("parameters_size", None)
     if "gate" in cfg:  # states written before the guard was renamed
         cfg["guard"] = cfg.pop("gate")
-    rule = RobustRule(**cfg.pop("rule"))
-    a = cls(size, rule=rule, **cfg)
-    a._n_in, a._n_out = state["n_in"], state["n_out"]
-    a._names = None if state["names"] is None else tuple(tuple(n) for n in state["names"])
-    if a._n_in is not None:
-        a._buffer = SampleBuffer(a._n_in + a._n_out)
-        data = _unarr(state["buf"])
-        if data is not None and data.size:
-            a._buffer.data = data
-        a._buffer.start = int(state["buf_start"])
-    a._n_seen = int(state["n_seen"])
-    a._j_done = int(state["j_done"])
-    a._last_theta = _unarr(state["last_theta"])
-    a._last_c = _unarr(state["last_c"])
-    hm = state["has_model"]
-    a._has_model = None if hm is None else np.asarray(hm, dtype=bool)
-    if state["factor"] is not None:
-        a._decimator = Decimator(int(state["factor"]))
-        a._decimator.zi = _unarr(state["dec_zi"])
-        a._decimator.phase = int(state["dec_phase"])
-    a._record_dt = state.get("record_dt")
-    return a
+    rule = cfg.pop("rule", None)
+    if not isinstance(rule, dict):
+        raise StateError("state['config']['rule'] must be an object of thresholds.")
+    try:
+        return cls(size, rule=RobustRule(**rule), **cfg)
+    except (TypeError, ValueError) as exc:
+        raise StateError(f"state['config'] does not describe an appraiser: {exc}") from None
+
+
+def _names(names: Any, n_in: int, n_out: int) -> tuple[tuple[str, ...], ...] | None:
+    if names is None:
+        return None
+    ok = (
+        isinstance(names, list)
+        and len(names) == 2
+        and all(isinstance(g, list) and all(isinstance(n, str) for n in g) for g in names)
+        and (len(names[0]), len(names[1])) == (n_in, n_out)
+    )
+    if not ok:
+        raise StateError(f"state['names'] must be [{n_in} input names, {n_out} output names].")
+    return tuple(names[0]), tuple(names[1])
+
+
+def _restore_decimator(a: Any, state: dict[str, Any], channels: int) -> None:
+    factor = state.get("factor")
+    if factor is None:
+        return
+    factor = field(state, "factor", int)
+    if factor < 1 or (factor > 1 and a.sample_time is None):
+        raise StateError(
+            f"state['factor']={factor}: decimation needs factor >= 1, and a factor above 1 "
+            "needs a sample_time to decimate to."
+        )
+    a._decimator = Decimator(factor)
+    if factor > 1 and state.get("dec_zi") is not None:
+        a._decimator.zi = checked_array(state["dec_zi"], "dec_zi", (2, 2, channels))
+    phase = field(state, "dec_phase", int)
+    if not 0 <= phase < factor:
+        raise StateError(f"state['dec_phase'] must be in [0, {factor}); got {phase}.")
+    a._decimator.phase = phase
 
 
 def save(a: Any, path: str) -> None:
@@ -124,4 +198,5 @@ def save(a: Any, path: str) -> None:
 def load(cls: Any, path: str) -> Any:
     """Read an appraiser saved with :func:`save`."""
     with open(path, encoding="utf-8") as fh:
-        return restore(cls, json.load(fh))
+        text = fh.read(MAX_STATE_BYTES + 1)
+    return restore(cls, parse_json(text))

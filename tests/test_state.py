@@ -1,0 +1,108 @@
+"""Saved appraiser states: damaged or edited ones are refused before they reach the kernel."""
+
+from __future__ import annotations
+
+import copy
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import clpc
+from clpc import CLPC
+from clpc.appraiser.state_schema import StateError
+
+DEN = np.array([1.0, -1.5, 0.7])
+NUM = np.array([0.2, 0.5, 0.1])
+
+
+@pytest.fixture(scope="module")
+def saved():
+    rng = np.random.default_rng(31)
+    u = rng.standard_normal(3000)
+    y = clpc.simulate_arx(DEN, NUM, u) + 0.01 * rng.standard_normal(3000)
+    a = CLPC(3, 201, 12)
+    a.push(u[:2000], y[:2000])
+    return json.loads(json.dumps(a.state_dict())), u, y
+
+
+def _arr(values):
+    values = np.asarray(values, dtype=float)
+    return {"shape": list(values.shape), "data": values.ravel().tolist()}
+
+
+def _drop_rows(state, rows):
+    buf = np.asarray(state["buf"]["data"]).reshape(state["buf"]["shape"])
+    state["buf"] = _arr(buf[rows:])
+
+
+TAMPERED = [
+    ("n_seen", lambda s: s.update(n_seen=10**9), "n_seen"),
+    ("n_seen negative", lambda s: s.update(n_seen=-5), ">= 0"),
+    ("last_theta shape", lambda s: s.update(last_theta=_arr([[1, 2, 3]])), "last_theta"),
+    ("buf_start large", lambda s: s.update(buf_start=10**6), "buffer holds samples"),
+    ("buf_start negative", lambda s: s.update(buf_start=-100), ">= 0"),
+    ("truncated buffer", lambda s: _drop_rows(s, 50), "buffer holds samples"),
+    ("j_done negative", lambda s: s.update(j_done=-1), ">= 0"),
+    ("j_done off", lambda s: s.update(j_done=s["j_done"] + 1), "j_done"),
+    ("factor 0", lambda s: s.update(factor=0), "factor"),
+    ("factor 3", lambda s: s.update(factor=3), "factor"),
+    ("window changed", lambda s: s["config"].update(window_size=40), "buf_start|j_done"),
+    ("NaN in buffer", lambda s: s["buf"]["data"].__setitem__(5, float("nan")), "non-finite"),
+    ("missing key", lambda s: s.pop("j_done"), "j_done"),
+    ("wrong type", lambda s: s.update(n_seen="2000"), "n_seen"),
+    ("bool counter", lambda s: s.update(j_done=True), "j_done"),
+    ("has_model", lambda s: s.update(has_model=[1]), "has_model"),
+    ("config", lambda s: s["config"].update(window_size=True), "config"),
+    ("names", lambda s: s.update(names=[["u"], ["y", "z"]]), "names"),
+]
+
+
+@pytest.mark.parametrize(("what", "edit", "match"), TAMPERED, ids=[t[0] for t in TAMPERED])
+def test_tampered_states_are_refused_with_the_field(saved, what, edit, match):
+    state = copy.deepcopy(saved[0])
+    edit(state)
+    with pytest.raises(StateError, match=match):
+        CLPC.from_state_dict(state)
+
+
+def test_untampered_state_continues_identically(saved):
+    state, u, y = saved
+    whole = CLPC(3, 201, 12).run(u, y)
+    resumed = CLPC.from_state_dict(copy.deepcopy(state)).push(u[2000:], y[2000:])
+    np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
+
+
+@pytest.mark.parametrize(
+    "text", ["[]", "3", '"x"', "{" * 100 + "}" * 100, '{"a": 1' + "0" * 500 + "}"]
+)
+def test_files_that_are_not_states(tmp_path, text):
+    path = tmp_path / "state.json"
+    path.write_text(text)
+    with pytest.raises(StateError):
+        CLPC.load(str(path))
+
+
+def test_the_former_crashes_end_in_a_clear_error_in_a_real_process(saved, tmp_path):
+    # these edits used to crash the interpreter inside the compiled kernel (segfault,
+    # heap corruption); run them in a child process so that a crash fails this test
+    state = saved[0]
+    for name, edit in (
+        ("n_seen", lambda s: s.update(n_seen=10**9)),
+        ("last_theta", lambda s: s.update(last_theta=_arr([[1, 2, 3]]))),
+    ):
+        tampered = copy.deepcopy(state)
+        edit(tampered)
+        path = tmp_path / f"{name}.json"
+        path.write_text(json.dumps(tampered))
+        code = (
+            "import numpy as np, clpc\n"
+            "from clpc.appraiser.state_schema import StateError\n"
+            f"try:\n    clpc.CLPC.load({str(path)!r}).push(np.ones(500), np.ones(500))\n"
+            "except StateError as e:\n    print('refused:', e)\n"
+        )
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+        assert "refused:" in proc.stdout
