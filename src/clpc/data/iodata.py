@@ -125,7 +125,7 @@ class IOData:
                 f"got len(u)={u_arr.shape[0]}, len(y)={y_arr.shape[0]}. "
                 "Trim both records to a common time span."
             )
-        dt = _check_dt(dt)
+        dt = check_dt(dt)
         in_names = _names(input_names, u_cols, u_arr.shape[1], "u", "input_names")
         out_names = _names(output_names, y_cols, y_arr.shape[1], "y", "output_names")
         _check_finite(u_arr, "u", in_names)
@@ -182,7 +182,8 @@ class IOData:
             )
 
 
-def _check_dt(dt: Any) -> float:
+def check_dt(dt: Any) -> float:
+    """``dt`` as a positive finite number of seconds (:class:`DataError` otherwise)."""
     try:
         value = float(dt)
     except (TypeError, ValueError):
@@ -230,7 +231,7 @@ def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: An
     if isinstance(u, IOData):
         if y is not None:
             raise DataError("pass either an IOData or (u, y), not both.")
-        if dt is not None and _check_dt(dt) != u.dt:
+        if dt is not None and check_dt(dt) != u.dt:
             return IOData(u.u, u.y, dt, u.input_names, u.output_names)
         return u
     if y is None:

@@ -9,12 +9,12 @@ uniformly sampled.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
-from clpc.data import DataError, IOData
+from clpc.data import DataError
+from clpc.data.iodata import IOData, check_dt
 from clpc.io.errors import show
 from clpc.io.loading import read_table
 from clpc.io.table import ColumnKey, Columns, PathLike, Table
@@ -99,9 +99,7 @@ def load_iodata(
 
 def _check_dt_agrees(dt: float, step: float, table: Table, time_rtol: float) -> None:
     """``dt`` must be positive and agree with the step of the time column (the last one)."""
-    given = float(dt)
-    if not (math.isfinite(given) and given > 0):
-        raise DataError(f"dt (sample time) must be a positive number of seconds; got {dt!r}.")
+    given = check_dt(dt)
     if abs(step - given) > time_rtol * given:
         raise DataError(
             f"dt={given:g} s disagrees with time column {table.names[-1]!r} of "
