@@ -500,3 +500,10 @@ def test_default_guard_never_holds_an_untrusted_model_on_real_records(name):
     est = trace.arrays["theta_estimate"][:, 0][trusted[:, 0]]
     for row in trace.arrays["theta"][:, 0][ok]:
         assert np.any(np.all(est == row, axis=1))
+
+
+def test_convergence_of_a_trace_without_updates():
+    trace = CLPC(3, 201, 12).run(np.arange(10.0), np.arange(10.0))  # 8 lag rows: no update
+    assert len(trace) == 0
+    conv = trace.convergence()
+    assert not conv.converged and conv.reason

@@ -558,7 +558,7 @@ def test_mode_errors_through_fit():
 @pytest.mark.parametrize("ratio", [0, -1.0, float("nan"), float("inf")])
 def test_noise_ratio_must_be_positive(noisy_siso, ratio):
     with pytest.raises(
-        ValueError, match=r"noise_ratio \(input/output noise variance\) must be > 0"
+        ValueError, match=r"noise_ratio \(input/output noise variance\) must be (> 0|finite)"
     ):
         LPC(noise_ratio=ratio).fit(*noisy_siso)
 
@@ -620,3 +620,16 @@ def test_default_is_consistent_under_eiv_with_unequal_channel_spreads():
     assert long[0] < 0.45 * short[0]  # falls like 1/sqrt(T) (0.32 for 10x the samples)
     assert lpc < ls / 10  # a tenth of least squares' error at T = 1e5
     assert std > 0.08 and ls > 0.08  # both biased: they do not fall with T
+
+
+def test_lpc_solve_with_fewer_rows_than_parameters_stays_finite():
+    mats = np.random.default_rng(0).standard_normal((1, 4, 6))
+    res = lpc_solve(mats, n_output_cols=3, blocks=[slice(0, 3), slice(3, 6)])
+    assert res.theta.shape == (1, 6) and np.all(np.isfinite(res.theta))
+
+
+def test_robust_rule_thresholds_are_checked():
+    with pytest.raises(ValueError, match=r"RobustRule.separation must be a number in \[0, 1\]"):
+        clpc.RobustRule(separation="x")
+    with pytest.raises(ValueError, match="degeneracy_ratio"):
+        clpc.RobustRule(degeneracy_ratio=0.5)

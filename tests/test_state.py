@@ -106,3 +106,32 @@ def test_the_former_crashes_end_in_a_clear_error_in_a_real_process(saved, tmp_pa
         proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
         assert proc.returncode == 0, proc.stderr
         assert "refused:" in proc.stdout
+
+
+def test_state_with_a_model_but_a0_zero_is_refused(saved):
+    state = copy.deepcopy(saved[0])
+    theta = np.asarray(state["last_theta"]["data"])
+    theta[0] = 0.0
+    state["last_theta"]["data"] = theta.tolist()
+    with pytest.raises(StateError, match="a0 = 0"):
+        CLPC.from_state_dict(state)
+
+
+def test_bad_settings_in_a_state_are_state_errors(saved):
+    for edit in (
+        lambda s: s["config"].update(mimo="both"),
+        lambda s: s.update(record_dt=-1.0),
+        lambda s: s["config"]["rule"].update(separation="x"),
+    ):
+        state = copy.deepcopy(saved[0])
+        edit(state)
+        with pytest.raises(StateError):
+            CLPC.from_state_dict(state)
+
+
+def test_json_depth_counts_brackets_outside_strings_only():
+    from clpc.appraiser.state_schema import parse_json
+
+    assert parse_json('{"a": "\\"' + "[" * 50 + '"}') == {"a": '"' + "[" * 50}
+    with pytest.raises(StateError, match="nested deeper"):
+        parse_json('{"a": "\\\\"' + ", " + '"b": ' + "[" * 50 + "]" * 50 + "}")

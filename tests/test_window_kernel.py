@@ -13,7 +13,7 @@ import pytest
 
 import clpc
 from clpc import CLPC, DataError, Trace
-from clpc.appraiser import engine as engine_module
+from clpc.core import jit as engine_module
 from clpc.core.small_eigh import sym_eig
 from lpc_reference import reference_clpc
 

@@ -83,8 +83,9 @@ def convergence(
         scale = np.maximum(np.abs(d[1:]), np.finfo(float).tiny)
         dd = (np.abs(d[1:] - d[:-1]) / scale).max(axis=1)
         quiet[1:] = acc[1:] & acc[:-1] & (dtheta < theta_tol) & (dd < D_tol)
-    run = np.convolve(quiet.astype(int), np.ones(consecutive, dtype=int), "valid")
-    hits = np.flatnonzero(run == consecutive) if run.size else np.array([], int)
+    window = np.ones(consecutive, dtype=int)
+    run = np.convolve(quiet.astype(int), window, "valid") if n >= consecutive else window[:0]
+    hits = np.flatnonzero(run == consecutive)
     trusted = trace.arrays.get("trusted")
     frac = float(trusted.all(axis=1).mean()) if trusted is not None and n else 1.0
     none = (float("nan"), theta_tol, D_tol, consecutive, float("nan"), float("nan"))

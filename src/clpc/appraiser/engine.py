@@ -8,39 +8,17 @@ otherwise.
 
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import numpy as np
 
 from clpc.appraiser import kernel
-from clpc.core.jit import compiled, numba_available
+from clpc.core.jit import ENGINES, compiled, resolve_engine
 from clpc.core.rules import RobustRule, SolveSettings, solve_settings, transform_mode
 from clpc.lpc.solve import fixed_transform
 from clpc.model.structure import Structure
 
 __all__ = ["ENGINES", "Engine", "resolve_engine", "window_plan"]
-
-ENGINES = ("auto", "compiled", "python")
-
-
-def resolve_engine(engine: Any) -> str:
-    """The engine to use: ``engine``, with ``"auto"`` read from ``CLPC_ENGINE`` if set."""
-    if engine == "auto":
-        engine = os.environ.get("CLPC_ENGINE", "auto") or "auto"
-    if engine not in ENGINES:
-        raise ValueError(
-            f"engine must be 'auto', 'compiled' or 'python' (argument or CLPC_ENGINE); got "
-            f"{engine!r}."
-        )
-    if engine == "compiled" and not numba_available():
-        raise ValueError(
-            "engine='compiled' needs numba, which is not installed: pip install numba, "
-            "or use engine='python' (slow)."
-        )
-    if engine == "auto":
-        return "compiled" if numba_available() else "python"
-    return str(engine)
 
 
 def window_plan(

@@ -14,8 +14,8 @@ Semantics (``docs/clpc.md`` says the same):
   sample, ``k = max_lag + m - 1``.
 * An update with fewer than ``min_rows`` rows is flagged ``not_enough_data``; degenerate
   windows (nothing varies, a constant channel) are flagged ``degenerate``; with the guard (the
-  default) only a *trusted* window's estimate is accepted: enough rows, channels excited
-  above their quantization, a solution the data determine (see :mod:`clpc.core.rules`). An
+  default) only a *trusted* window's estimate is accepted: enough rows, an output excited
+  above its quantization, a solution the data determine (see :mod:`clpc.core.rules`). An
   update that is not accepted holds the last accepted parameters; parameters are never NaN
   (zeros, with ``has_model=False``, until a first estimate is accepted).
 * ``sample_time``: data sampled faster by an integer factor are low-pass filtered (causal

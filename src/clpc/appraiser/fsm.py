@@ -20,6 +20,7 @@ from clpc.appraiser.updates import KernelSetup, TraceLabels, empty_arrays, solve
 from clpc.core.rules import trust_rows
 from clpc.data import DataError
 from clpc.lpc.regressors import miso_regressor
+from clpc.lpc.solve import noise_covariance
 from clpc.model.structure import check_mode, default_mode
 
 __all__ = [
@@ -56,15 +57,8 @@ def min_rows(a: Any) -> int:
 
 
 def noise(a: Any) -> np.ndarray | None:
-    if a.noise_cov is not None:
-        return a.noise_cov
-    if a.noise_ratio is None:
-        return None
-    s = a.structure
-    ratio = float(a.noise_ratio)
-    if not np.isfinite(ratio) or ratio <= 0:
-        raise ValueError(f"noise_ratio must be > 0; got {a.noise_ratio!r}.")
-    return np.concatenate([np.ones(s.na + 1), np.full(n_blocks(a) * (s.nb + 1), ratio)])
+    """The lag vector's known noise covariance, if any (:func:`clpc.lpc.solve.noise_covariance`)."""
+    return noise_covariance(a.noise_cov, a.noise_ratio, a.structure, n_blocks(a))
 
 
 def time_step(a: Any) -> float:

@@ -103,6 +103,15 @@ def restore(cls: Any, state: Any) -> Any:
     Every field is checked first (:mod:`clpc.appraiser.state_schema`); a damaged or edited
     state raises :class:`~clpc.appraiser.state_schema.StateError` naming the field.
     """
+    try:
+        return _restore(cls, state)
+    except StateError:
+        raise
+    except (TypeError, ValueError, KeyError) as exc:
+        raise StateError(f"the state does not describe an appraiser: {exc}") from None
+
+
+def _restore(cls: Any, state: Any) -> Any:
     if not isinstance(state, dict):
         raise StateError(f"a state must be a JSON object; got {type(state).__name__}.")
     if state.get("format") != FORMAT or state.get("version") != VERSION:
@@ -134,6 +143,8 @@ def restore(cls: Any, state: Any) -> Any:
     if not isinstance(hm, list) or len(hm) != n_out or not all(isinstance(x, bool) for x in hm):
         raise StateError(f"state['has_model'] must be {n_out} booleans; got {hm!r:.60}.")
     a._has_model = np.asarray(hm, dtype=bool)
+    if np.any(a._has_model & ~(np.abs(a._last_theta[:, 0]) > 0)):
+        raise StateError("state['last_theta'] has a0 = 0 for an output with a model.")
     _restore_decimator(a, state, n_in + n_out)
     record_dt = state.get("record_dt")
     if record_dt is not None:

@@ -52,8 +52,11 @@ def _depth(text: str) -> int:
     in_string = escaped = False
     for ch in text:
         if in_string:
-            escaped = not escaped and ch == "\\"
-            if ch == '"' and not escaped:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == '"':
                 in_string = False
             continue
         if ch == '"':

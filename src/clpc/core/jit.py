@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import importlib.util
+import os
 import types
 from collections.abc import Callable
 from pathlib import Path
@@ -26,7 +27,7 @@ from typing import Any, TypeVar
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["compiled", "kernel", "numba_available"]
+__all__ = ["ENGINES", "compiled", "kernel", "numba_available", "resolve_engine"]
 
 _MARKED: dict[int, Callable[..., Any]] = {}
 _TWINS: dict[int, Any] = {}
@@ -35,6 +36,28 @@ _TWINS: dict[int, Any] = {}
 def numba_available() -> bool:
     """Whether numba can be imported (it is a core dependency; this guards odd installs)."""
     return importlib.util.find_spec("numba") is not None
+
+
+ENGINES = ("auto", "compiled", "python")
+
+
+def resolve_engine(engine: Any) -> str:
+    """The engine to use: ``engine``, with ``"auto"`` read from ``CLPC_ENGINE`` if set."""
+    if engine == "auto":
+        engine = os.environ.get("CLPC_ENGINE", "auto") or "auto"
+    if engine not in ENGINES:
+        raise ValueError(
+            f"engine must be 'auto', 'compiled' or 'python' (argument or CLPC_ENGINE); got "
+            f"{engine!r}."
+        )
+    if engine == "compiled" and not numba_available():
+        raise ValueError(
+            "engine='compiled' needs numba, which is not installed: pip install numba, "
+            "or use engine='python' (slow)."
+        )
+    if engine == "auto":
+        return "compiled" if numba_available() else "python"
+    return str(engine)
 
 
 def kernel(fn: F) -> F:

@@ -2,7 +2,7 @@
 
 Plain Python in numba's subset (see :mod:`clpc.core.jit`): the model calls them as they
 are, the CLPC kernel compiles them into its loop, :func:`monic_many` and
-:func:`stable_many` run them compiled over whole traces.
+:func:`stable_many` run them compiled over many equations at once.
 
 Conventions (paper eq. 17, ``y^T a + u^T b = r``): ``theta = [a_0..a_na, b_0..b_nb, ...]``
 (one ``b`` block per input, or a single block for the paper's paired MIMO). The monic

@@ -86,7 +86,8 @@ class RobustRule:
     ----------
     min_a0_weight : float
         An eigenvector of the solved scatter matrix is a candidate system relation when
-        its ``y(n)`` component ``|v[a0]|`` is at least this (0..1). Smaller eigenvectors
+        its unit-free ``y(n)`` weight (:func:`clpc.core.solution.unit_free_weights`) is at
+        least this (0..1). Smaller eigenvectors
         below the first candidate are relations that do not determine ``y(n)``.
     degeneracy_ratio : float, optional
         Eigenvalues within this factor of the candidate's belong to the same near-null
@@ -111,6 +112,28 @@ class RobustRule:
     zero_tol: float = 1e-12
     min_output_weight: float = 0.05
     separation: float = 0.1
+
+    def __post_init__(self) -> None:
+        for name, low, high in (
+            ("min_a0_weight", 0.0, 1.0),
+            ("zero_tol", 0.0, 1.0),
+            ("min_output_weight", 0.0, 1.0),
+            ("separation", 0.0, 1.0),
+        ):
+            value = getattr(self, name)
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not (ok and low <= value <= high):
+                raise ValueError(
+                    f"RobustRule.{name} must be a number in [{low:g}, {high:g}]; got {value!r}."
+                )
+        ratio = self.degeneracy_ratio
+        if ratio is not None and not (
+            isinstance(ratio, (int, float)) and not isinstance(ratio, bool) and ratio >= 1.0
+        ):
+            raise ValueError(
+                f"RobustRule.degeneracy_ratio must be None (Marchenko-Pastur) or a number >= 1; "
+                f"got {ratio!r}."
+            )
 
 
 class SolveSettings(NamedTuple):

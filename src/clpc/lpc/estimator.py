@@ -20,7 +20,7 @@ from clpc.core import rules
 from clpc.data import DataError, IOData, as_iodata
 from clpc.lpc.reduction import reduce_model
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from clpc.lpc.solve import RobustRule, SolveResult, solve_scatter
+from clpc.lpc.solve import RobustRule, SolveResult, noise_covariance, solve_scatter
 from clpc.model import LinearModel
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
@@ -139,7 +139,8 @@ class LPC:
     nk : int
         Input delay in samples (default 0: ``b0`` present, as in the paper).
     method : {"robust", "paper"}
-        ``"paper"``: the literal smallest eigenvector of the scatter matrix.
+        ``"paper"``: the literal smallest eigenvector of the solved problem (the scatter
+        matrix itself with the default ``scaling="none"``).
         ``"robust"`` (default): the excitation-aware nongeneric TLS solution - relations
         that do not involve ``y(n)`` (judged unit-free) are set aside and the minimum-norm
         ``a0 = 1`` vector of the near-null subspace is taken (:mod:`clpc.core.rules`).
@@ -187,20 +188,6 @@ class LPC:
         """The :class:`Structure` these settings describe."""
         return Structure.from_settings(self.order, self.na, self.nb, self.nk)
 
-    def _noise_cov(self, structure: Structure, n_blocks: int) -> np.ndarray | None:
-        if self.noise_cov is not None:
-            return np.asarray(self.noise_cov, dtype=np.float64)
-        if self.noise_ratio is None:
-            return None
-        ratio = float(self.noise_ratio)
-        if not np.isfinite(ratio) or ratio <= 0:
-            raise ValueError(
-                f"noise_ratio (input/output noise variance) must be > 0; got {self.noise_ratio!r}."
-            )
-        return np.concatenate(
-            [np.ones(structure.na + 1), np.full(n_blocks * (structure.nb + 1), ratio)]
-        )
-
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
         """Identify the model from a record.
 
@@ -237,7 +224,7 @@ class LPC:
             n_output_cols=structure.na + 1,
             blocks=structure_blocks(structure, n_blocks),
             method=self.method,
-            noise_cov=self._noise_cov(structure, n_blocks),
+            noise_cov=noise_covariance(self.noise_cov, self.noise_ratio, structure, n_blocks),
             rule=rule,
             scaling=self.scaling,
         )

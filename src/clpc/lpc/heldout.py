@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["HeldOutScore", "horizon", "score", "stability"]
+__all__ = ["HeldOutScore", "fit_percent", "horizon", "score", "stability"]
 
 #: A pole within this distance of the unit circle is on it (an integrator): an integrator
 #: estimated from noisy data lands a few thousandths from z = 1 (the ball-and-beam record,
@@ -55,7 +55,11 @@ class HeldOutScore:
 
 
 def stability(model: Any) -> str:
-    """``"stable"``, ``"integrating"`` (poles on the unit circle) or ``"unstable"``."""
+    """How the model's largest pole sits against the unit circle.
+
+    ``"stable"``, ``"integrating"`` (on the circle, within :data:`UNIT_CIRCLE_TOL`),
+    ``"unstable"``, or ``"no model"`` when the poles do not exist (``a0 = 0``).
+    """
     try:
         radius = max(float(np.max(np.abs(model.poles(j)))) for j in range(model.n_outputs))
     except (ValueError, np.linalg.LinAlgError):
@@ -78,7 +82,8 @@ def horizon(model: Any, n_heldout: int) -> int:
     return int(min(max(round(tau), MIN_HORIZON), longest))
 
 
-def _fit(y: np.ndarray, y_hat: np.ndarray) -> float:
+def fit_percent(y: np.ndarray, y_hat: np.ndarray) -> float:
+    """``100 (1 - ||y - y_hat|| / ||y - mean y||)`` (-inf when it diverges)."""
     with np.errstate(all="ignore"):
         err = float(np.linalg.norm(y - y_hat))
         ref = float(np.linalg.norm(y - y.mean(axis=0)))
@@ -102,6 +107,6 @@ def score(model: Any, data: Any, split: int, k: int) -> HeldOutScore:
         sim = np.asarray(model.simulate(data.u)).reshape(data.y.shape)[split:]
         pred = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
     start = model.structure.max_lag + k
-    free_run = _fit(val.y, sim)
-    kstep = _fit(val.y[start:], pred[start:])
+    free_run = fit_percent(val.y, sim)
+    kstep = fit_percent(val.y[start:], pred[start:])
     return HeldOutScore(free_run, kstep, 0.5 * (free_run + kstep), kind)

@@ -165,7 +165,7 @@ def _estimate(
     n = centered.shape[0]
     scat = centered.T @ centered / n
     is_y = np.arange(mat.shape[1]) <= lag
-    # start from the smallest eigenvalue of the channel-scaled problem
+    # start from 1 % of each channel's mean lag variance
     var = np.array([np.mean(np.diag(scat)[is_y]), np.mean(np.diag(scat)[~is_y])]) * 1e-2
     converged = False
     clamped = False

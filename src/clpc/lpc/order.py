@@ -271,9 +271,7 @@ def select_delay(
         model = replace(base, nk=int(nk)).fit(est)
         y_hat = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
         start = replace(base, nk=int(cands[-1])).structure().max_lag
-        err = np.linalg.norm(val.y[start:] - y_hat[start:])
-        ref = np.linalg.norm(val.y[start:] - val.y[start:].mean(axis=0))
-        fits.append(100.0 * (1.0 - err / ref) if np.isfinite(err) and ref > 0 else -np.inf)
+        fits.append(heldout.fit_percent(val.y[start:], y_hat[start:]))
     fit = np.array(fits)
     best = int(cands[np.flatnonzero(fit >= fit.max() - parsimony)[0]])
     return DelaySelection(cands, fit, best)

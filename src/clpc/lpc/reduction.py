@@ -16,6 +16,7 @@ import numpy as np
 
 from clpc.core.polynomials import CANCEL_DISTANCE, cancel_common_factors
 from clpc.data import IOData
+from clpc.lpc.heldout import fit_percent
 from clpc.lpc.regressors import regressors
 from clpc.model import LinearModel, MimoMode, ModelError, Structure
 
@@ -90,15 +91,7 @@ def _fits(model: LinearModel, data: IOData) -> tuple[float, float]:
         sim = np.asarray(model.simulate(data.u)).reshape(data.y.shape)
         pred = np.asarray(model.predict(data.u, data.y, k=CHECK_HORIZON)).reshape(data.y.shape)
     start = model.structure.max_lag + CHECK_HORIZON
-    return _fit(data.y, sim), _fit(data.y[start:], pred[start:])
-
-
-def _fit(y: np.ndarray, y_hat: np.ndarray) -> float:
-    err = np.linalg.norm(y - y_hat)
-    ref = np.linalg.norm(y - y.mean(axis=0))
-    if not (np.isfinite(err) and ref > 0):
-        return -np.inf
-    return float(100.0 * (1.0 - err / ref))
+    return fit_percent(data.y, sim), fit_percent(data.y[start:], pred[start:])
 
 
 def _theta(den: np.ndarray, num: np.ndarray, mode: str, j: int, nk: int) -> np.ndarray:

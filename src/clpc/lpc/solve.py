@@ -13,14 +13,14 @@ under ``||theta|| = 1`` is the eigenvector of the smallest eigenvalue of ``A``
 (eqs. 28-32), ``c = Z^T theta`` (eq. 24) and ``sigma_r^2 = theta^T A theta / n``.
 
 ``method="paper"``
-    The literal eigenvector of the smallest eigenvalue of ``A`` (no scaling).
+    The literal eigenvector of the smallest eigenvalue of the solved problem (``A`` itself
+    with the default ``scaling="none"``).
 ``method="robust"`` (default)
     See :func:`clpc.core.solution.pick_robust` and ``docs/method.md``.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -28,15 +28,15 @@ from typing import Any
 import numpy as np
 
 from clpc.core import rules, solution
-from clpc.core.jit import compiled
+from clpc.core.checks import check_positive
+from clpc.core.jit import compiled, resolve_engine
 from clpc.core.rules import (
     NO_TRANSFORM,
-    ROUNDING_VARIANCE_FACTOR,
     RobustRule,
     solve_settings,
 )
 
-__all__ = ["ROUNDING_VARIANCE_FACTOR", "RobustRule", "SolveResult", "solve_scatter"]
+__all__ = ["RobustRule", "SolveResult", "noise_covariance", "solve_scatter"]
 
 
 @dataclass(frozen=True)
@@ -66,7 +66,7 @@ class SolveResult:
     degenerate : ndarray of bool, shape (batch...)
         The scatter matrix is (numerically) zero or has a constant channel: nothing to fit.
     a0_weight : ndarray, shape (batch...)
-        ``|y(n)|`` component of the solution in the solved (whitened) problem, unit-free;
+        The solution's unit-free ``y(n)`` weight (:func:`clpc.core.solution.unit_free_weights`);
         near 0 the solution does not determine ``y(n)`` and has no monic form.
     """
 
@@ -83,8 +83,27 @@ class SolveResult:
 
 
 def engine_fn(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """The compiled twin of a rule, or the plain function when ``CLPC_ENGINE=python``."""
-    return fn if os.environ.get("CLPC_ENGINE") == "python" else compiled(fn)
+    """The compiled twin of a rule, or the plain function under the ``"python"`` engine."""
+    return fn if resolve_engine("auto") == "python" else compiled(fn)
+
+
+def noise_covariance(
+    noise_cov: Any, noise_ratio: Any, structure: Any, n_blocks: int
+) -> np.ndarray | None:
+    """The lag vector's noise covariance from the user's ``noise_cov`` or ``noise_ratio``.
+
+    ``noise_ratio`` (input over output noise variance) gives the diagonal covariance
+    ``diag(1, ..., 1, r, ..., r)``: 1 on the ``na + 1`` output lags, ``r`` on the input lags
+    of ``n_blocks`` input blocks. ``None`` when neither is given.
+    """
+    if noise_cov is not None:
+        return np.asarray(noise_cov, dtype=np.float64)
+    if noise_ratio is None:
+        return None
+    ratio = check_positive(noise_ratio, "noise_ratio (input/output noise variance)")
+    return np.concatenate(
+        [np.ones(structure.na + 1), np.full(n_blocks * (structure.nb + 1), ratio)]
+    )
 
 
 def _column_channels(blocks: list[slice], p: int) -> np.ndarray:
@@ -126,7 +145,8 @@ def solve_scatter(
     noise_cov : ndarray, shape (p,) or (p, p), optional
         Covariance ``W`` of the noise on the lag vector (weighted LPC: the generalized
         eigenproblem ``A theta = lambda W theta``); 1-D means diagonal (variances).
-        Default: ``method="paper"`` uses the identity, ``"robust"`` the channel variances.
+        Default: ``scaling`` decides (``"none"``: the identity; ``"std"``: the channels'
+        variances).
     rule : RobustRule, optional
         Thresholds of the robust solution.
     data : ndarray, shape (k, n, p), optional
@@ -164,9 +184,8 @@ def solve_scatter(
         scales, tmat, mat = np.ones(p), np.empty((p, p)), np.empty((p, p))
         scales_of(scatter[i], n_rows_f[i], col_channel, len(blocks), scales)
         matrix_of(scatter[i], mode, fixed, scales, tmat, mat)
-        vals, vecs, raw = _decompose(
-            mat, tmat, scatter[i], None if data is None else data[i], mode == NO_TRANSFORM
-        )
+        rows = None if data is None or data.shape[1] < p else data[i]  # SVD needs n >= p
+        vals, vecs, raw = _decompose(mat, tmat, scatter[i], rows, mode == NO_TRANSFORM)
         res = finish(
             scatter[i],
             mean[i],
