@@ -485,6 +485,8 @@ def test_guard_settings_are_checked_and_saved(tmp_path):
     assert CLPC.from_state_dict(a.state_dict()).trust_rows == 30
     assert not CLPC.from_state_dict(a.state_dict()).guard
     assert CLPC(gate=False).guard is False  # the former name
+    with pytest.raises(ValueError, match="former name of guard"):
+        CLPC(guard=False, gate=True)
 
 
 @pytest.mark.parametrize("name", ["dryer", "robot_arm", "ballbeam", "exchanger"])

@@ -142,6 +142,11 @@ class CLPC:
         self.noise_ratio = noise_ratio
         self.noise_cov = None if noise_cov is None else np.asarray(noise_cov, dtype=float)
         self.rule = rule or RobustRule()
+        if gate is not None and gate != guard and not guard:
+            raise ValueError(
+                f"gate is the former name of guard; got guard={guard!r} and gate={gate!r}. "
+                "Pass one of them."
+            )
         self.guard = check_bool(guard if gate is None else gate, "guard")
         self.trust_rows = None if trust_rows is None else check_int(trust_rows, "trust_rows", 1)
         self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2)
