@@ -570,3 +570,18 @@ def test_closed_pipe_ends_quietly(record, tmp_path):
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 1
     assert "Traceback" not in err and "Error" not in err
+
+
+def test_stream_jsonl_survives_huge_numbers_and_deep_nesting(record):
+    _, u, y, _ = record
+    u, y = u[:200], y[:200]
+    lines = [json.dumps({"u": float(a), "y": float(b)}) for a, b in zip(u, y, strict=True)]
+    lines.insert(50, '{"u": 1' + "0" * 400 + ', "y": 1}')  # an int no float can hold
+    lines.insert(120, "[" * 100_000)  # deeper than the JSON parser recurses
+    res = ok(
+        "stream", "--format", "jsonl", "--window", "51", "--cluster", "7", input="\n".join(lines)
+    )
+    got = [json.loads(line) for line in res.stdout.splitlines()]
+    _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    assert "line 51: 'u' holds a number too large for a float" in res.stderr
+    assert "line 121: not a sample: JSON nested too deeply" in res.stderr

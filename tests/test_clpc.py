@@ -509,3 +509,11 @@ def test_convergence_of_a_trace_without_updates():
     assert len(trace) == 0
     conv = trace.convergence()
     assert not conv.converged and conv.reason
+
+
+def test_complex_samples_are_refused_not_truncated():
+    u = np.ones(300, dtype=complex)
+    y = np.ones(300)
+    for feed in (lambda a: a.run(u, y), lambda a: a.push(u, y)):
+        with pytest.raises(DataError, match="u must hold real numbers; got complex"):
+            feed(CLPC())

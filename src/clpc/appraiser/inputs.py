@@ -17,7 +17,15 @@ CHECK_SLICE = 1 << 20
 
 
 def as_columns(x: Any, name: str) -> np.ndarray:
-    """``x`` as a float array of shape (n, channels); scalars and 1-D become columns."""
+    """``x`` as a float array of shape (n, channels); scalars and 1-D become columns.
+
+    Complex values are refused (casting would drop the imaginary part without a word).
+    """
+    if np.iscomplexobj(x):
+        raise DataError(
+            f"{name} must hold real numbers; got complex values. Pass the real part (or the "
+            "magnitude) explicitly if that is what you mean."
+        )
     try:
         arr = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):

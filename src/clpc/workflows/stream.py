@@ -147,6 +147,8 @@ def parse_jsonl_sample(line: str, n_in: int, n_out: int) -> Sample:
         obj = json.loads(line)
     except json.JSONDecodeError as exc:
         raise ValueError(f"not valid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise ValueError("not a sample: JSON nested too deeply") from None
     if not isinstance(obj, dict) or "u" not in obj or "y" not in obj:
         raise ValueError('expected an object {"u": ..., "y": ...}')
     out = []
@@ -158,7 +160,10 @@ def parse_jsonl_sample(line: str, n_in: int, n_out: int) -> Sample:
         ):
             want = "a number" if n == 1 else f"a list of {n} numbers"
             raise ValueError(f"{key!r} must be {want}; got {val!r}")
-        out.append([float(v) for v in vals])
+        try:
+            out.append([float(v) for v in vals])
+        except OverflowError:
+            raise ValueError(f"{key!r} holds a number too large for a float") from None
     _finite(out[0] + out[1])
     return out[0], out[1]
 
