@@ -52,7 +52,7 @@ def exact_window(u, y, end_row, window, order=2):
 
 
 # ---------------------------------------------------------------- semantics
-@pytest.mark.parametrize(("window", "cluster"), [(201, 12), (30, 7), (24, 12), (10, 1)])
+@pytest.mark.parametrize(("window", "cluster"), [(201, 12), (30, 7), (24, 12), (12, 1)])
 def test_updates_every_cluster_growing_then_sliding(window, cluster):
     u, y = record(600)
     trace = CLPC(3, window, cluster).run(u, y)
@@ -517,3 +517,13 @@ def test_complex_samples_are_refused_not_truncated():
     for feed in (lambda a: a.run(u, y), lambda a: a.push(u, y)):
         with pytest.raises(DataError, match="u must hold real numbers; got complex"):
             feed(CLPC())
+
+
+def test_windows_that_can_never_hold_a_model_are_refused_up_front():
+    with pytest.raises(ValueError, match="window_size=3 cannot hold the 12 lag vectors"):
+        CLPC(window_size=3)
+    with pytest.raises(ValueError, match="1000 parameters need"):
+        CLPC(parameters_size=500)
+    miso = CLPC(3, 13, 1, mimo="miso")  # 12 parameters with 3 inputs: known at the data
+    with pytest.raises(ValueError, match="window_size=13 cannot hold the 24"):
+        miso.run(np.ones((100, 3)), np.ones(100))

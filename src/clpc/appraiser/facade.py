@@ -150,6 +150,7 @@ class CLPC:
         self.guard = check_bool(guard if gate is None else gate, "guard")
         self.trust_rows = None if trust_rows is None else check_int(trust_rows, "trust_rows", 1)
         self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2)
+        fsm.check_window(self, self.structure.n_params())  # one input: the fewest parameters
         self.sample_time = None if sample_time is None else _seconds(sample_time, "sample_time")
         self.data_sample_time = (
             None if data_sample_time is None else _seconds(data_sample_time, "data_sample_time")

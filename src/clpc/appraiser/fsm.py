@@ -24,6 +24,7 @@ from clpc.lpc.solve import noise_covariance
 from clpc.model.structure import check_mode, default_mode
 
 __all__ = [
+    "check_window",
     "consume",
     "empty_trace",
     "init_channels",
@@ -66,13 +67,25 @@ def time_step(a: Any) -> float:
     return a.sample_time or a._record_dt or a.data_sample_time or 1.0
 
 
+def check_window(a: Any, p: int) -> None:
+    """Refuse a window that can never hold ``min_rows`` lag vectors for ``p`` parameters."""
+    need = a.min_rows if a.min_rows is not None else 2 * p
+    if a.window_size < max(need, p + 1):
+        raise ValueError(
+            f"window_size={a.window_size} cannot hold the {max(need, p + 1)} lag vectors that "
+            f"{p} parameters need (min_rows, default 2 p): every update would be 'not enough "
+            f"data'. Use window_size >= {max(need, p + 1)} or fewer parameters."
+        )
+
+
 def init_channels(a: Any, n_in: int, n_out: int, names: Any = None) -> None:
     """Fix the record's channels on first data; later chunks must match them."""
     if a._n_in is None:
         a._n_in, a._n_out = n_in, n_out
         mode(a)  # validates
-        a._buffer = SampleBuffer(n_in + n_out)
         p = n_params(a)
+        check_window(a, p)
+        a._buffer = SampleBuffer(n_in + n_out)
         a._last_theta = np.zeros((n_out, p))
         a._last_c = np.zeros(n_out)
         a._has_model = np.zeros(n_out, dtype=bool)
