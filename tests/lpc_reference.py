@@ -57,36 +57,7 @@ def solve_scatter(
     data: np.ndarray | None = None,
     scaling: str = "none",
 ) -> SolveResult:
-    """Solve a stack of LPC problems given their scatter matrices.
-
-    Parameters
-    ----------
-    scatter : ndarray, shape (k, p, p)
-        Centered scatter matrices ``A`` (eq. 27).
-    mean : ndarray, shape (k, p)
-        Mean lag vectors ``Z`` (eq. 25).
-    n_rows : ndarray of int, shape (k,)
-        Number of lag vectors behind each matrix.
-    n_output_cols : int
-        Number of output columns (``na + 1``); column 0 is ``y(n)``, i.e. ``a0``.
-    blocks : list of slice
-        Column blocks, one per channel (output first), for the default scaling.
-    method : {"robust", "paper"}
-        See the module docstring.
-    noise_cov : ndarray, shape (p,) or (p, p), optional
-        Covariance ``W`` of the noise on the lag vector (weighted LPC: the generalized
-        eigenproblem ``A theta = lambda W theta``); 1-D means diagonal (variances).
-        Default: ``method="paper"`` uses the identity, ``"robust"`` the channel variances.
-    rule : RobustRule, optional
-        Thresholds of the robust solution.
-    data : ndarray, shape (k, n, p), optional
-        Centered data matrices; when given (one-shot fits) the decomposition is the SVD of
-        the data, which is more accurate than the eigen-decomposition of the scatter.
-
-    Returns
-    -------
-    SolveResult
-    """
+    """The old vectorised solve (arguments as :func:`clpc.lpc.solve.solve_scatter`)."""
     if method not in ("robust", "paper"):
         raise ValueError(f"method must be 'robust' or 'paper'; got {method!r}.")
     rule = rule or RobustRule()

@@ -37,6 +37,26 @@ Columns = Sequence[ColumnKey] | ColumnKey | None
 Chunks = Callable[[int], Iterator[tuple[np.ndarray, np.ndarray | None]]]
 
 
+def named_columns(names: Any, data: Any, who: tuple[str, str]) -> tuple[list[str], np.ndarray]:
+    """``data`` as a 2-D float array and ``names`` as one string per column.
+
+    ``who = (shape message, count phrase)`` starts the two messages, e.g. ``("Table data
+    must be 1-D or 2-D", "Table needs")``.
+    """
+    arr = np.asarray(data, dtype=np.float64)
+    if arr.ndim == 1:
+        arr = arr[:, None]
+    if arr.ndim != 2:
+        raise DataError(f"{who[0]}; got shape {arr.shape}.")
+    listed = [names] if isinstance(names, str) else [str(n) for n in names]
+    if len(listed) != arr.shape[1]:
+        raise DataError(
+            f"{who[1]} one name per column: {arr.shape[1]} column(s), "
+            f"{len(listed)} name(s) {listed}."
+        )
+    return listed, arr
+
+
 class Table:
     """Named numeric columns read from a file.
 
@@ -62,17 +82,7 @@ class Table:
     __slots__ = ("_first", "_lines", "_unit", "data", "names", "source")
 
     def __init__(self, names: Sequence[str], data: Any, source: str = "") -> None:
-        arr = np.asarray(data, dtype=np.float64)
-        if arr.ndim == 1:
-            arr = arr[:, None]
-        if arr.ndim != 2:
-            raise DataError(f"Table data must be 1-D or 2-D; got shape {arr.shape}.")
-        listed = [names] if isinstance(names, str) else [str(n) for n in names]
-        if len(listed) != arr.shape[1]:
-            raise DataError(
-                f"Table needs one name per column: {arr.shape[1]} column(s), "
-                f"{len(listed)} name(s) {listed}."
-            )
+        listed, arr = named_columns(names, data, ("Table data must be 1-D or 2-D", "Table needs"))
         self.names: list[str] = listed
         self.data: np.ndarray = arr
         self.source: str = str(source)

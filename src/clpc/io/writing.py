@@ -7,13 +7,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from clpc.data import DataError
 from clpc.io.formats import file_kind
 from clpc.io.numpy_files import write_npy, write_npz
 from clpc.io.parquet import write_parquet
-from clpc.io.table import PathLike
+from clpc.io.table import PathLike, named_columns
 from clpc.io.text_writer import write_text
 
 __all__ = ["write_table"]
@@ -55,17 +53,9 @@ def write_table(
     """
     p = Path(os.fspath(path))
     kind = file_kind(p)
-    arr = np.asarray(array, dtype=np.float64)
-    if arr.ndim == 1:
-        arr = arr[:, None]
-    if arr.ndim != 2:
-        raise DataError(f"write_table needs a 1-D or 2-D array; got shape {arr.shape}.")
-    listed = [names] if isinstance(names, str) else [str(n) for n in names]
-    if len(listed) != arr.shape[1]:
-        raise DataError(
-            f"write_table needs one name per column: {arr.shape[1]} column(s), {len(listed)} "
-            f"name(s) {listed}."
-        )
+    listed, arr = named_columns(
+        names, array, ("write_table needs a 1-D or 2-D array", "write_table needs")
+    )
     if kind == "text":
         if any("\n" in n or "\r" in n for n in listed):
             raise DataError(f"column names of a text file cannot contain line breaks: {listed}.")
