@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 __all__ = ["fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"]
 
@@ -137,4 +136,6 @@ def whiteness_test(residuals: Any, lags: int = 20) -> WhitenessResult:
     acf = np.fft.irfft(spec * np.conj(spec))[: lags + 1] / denom
     k = np.arange(1, lags + 1)
     q = n * (n + 2) * np.sum(acf[1:] ** 2 / (n - k))
+    from scipy import stats  # scipy.stats costs ~0.5 s to import: only where it is used
+
     return WhitenessResult(float(q), float(stats.chi2.sf(q, lags)), lags, acf[1:])
