@@ -36,7 +36,16 @@ __all__ = ["compare", "simulate"]
     default=None,
     help="Write the simulation here (csv, tsv, parquet, npy, npz); default stdout.",
 )
-def simulate(model_file: str, file: str, inputs: tuple[str, ...], out: str | None) -> None:
+@click.option(
+    "--time",
+    "time_col",
+    metavar="COL",
+    default=None,
+    help="A time column to keep (written first, unchanged).",
+)
+def simulate(
+    model_file: str, file: str, inputs: tuple[str, ...], out: str | None, time_col: str | None
+) -> None:
     """Simulate a saved model on the input columns of FILE (free run, zero initial state).
 
     Writes the input columns and one simulated column per output (named OUTPUT_sim).
@@ -45,8 +54,9 @@ def simulate(model_file: str, file: str, inputs: tuple[str, ...], out: str | Non
     Examples:
       clpc simulate model.json new_inputs.csv --input u --out sim.csv
       clpc simulate model.json new_inputs.csv > sim.csv
+      clpc simulate model.json log.csv --input u --time t > sim.csv
     """  # noqa: D301
-    result = simulate_file(model_file, file, inputs, out)
+    result = simulate_file(model_file, file, inputs, out, time_col)
     if out:
         click.echo(f"wrote {out} ({result.values.shape[0]} rows)", err=True)
     else:
@@ -82,7 +92,8 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
     """Compare a saved model with measured data: fit % of simulation or k-step prediction.
 
     The first max-lag samples give the initial conditions; the fit % (100 = perfect,
-    0 = as good as the mean) is computed over the rest.
+    0 = as good as the mean) is computed over the rest. Data whose --dt or --time says
+    they are sampled at another rate than the model's are refused.
 
     \b
     Examples:

@@ -180,12 +180,20 @@ def appraiser_options() -> Decorator:
     """The appraiser's options, collected into ``appraiser`` (:class:`AppraiserSettings`)."""
     return combine(
         click.option(
+            "--order",
+            "-n",
+            type=click.IntRange(min=1),
+            default=2,
+            show_default=True,
+            help="Model order N (na = nb = N), as in clpc identify.",
+        ),
+        click.option(
             "--parameters-size",
             "-p",
             type=click.IntRange(min=2),
-            default=3,
-            show_default=True,
-            help="Size of a and of b (N + 1).",
+            default=None,
+            hidden=True,
+            help="The paper's name for N + 1 (former option; use --order).",
         ),
         click.option(
             "--window",
@@ -205,11 +213,18 @@ def appraiser_options() -> Decorator:
         ),
         nk_option(),
         click.option(
+            "--decimate-to",
+            type=click.FloatRange(min=0, min_open=True),
+            default=None,
+            help="Sample time [s] the appraiser works at: an integer multiple of the data's "
+            "--dt (the data are low-pass filtered and decimated).",
+        ),
+        click.option(
             "--sample-time",
             type=click.FloatRange(min=0, min_open=True),
             default=None,
-            help="Sample time [s] the appraiser works at: an integer multiple of the "
-            "data's (the data are low-pass filtered and decimated).",
+            hidden=True,
+            help="Former name of --decimate-to.",
         ),
         method_option(),
         click.option(

@@ -190,7 +190,7 @@ def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> 
         raise DataError(
             f"the record is too short for the window: {run.appraiser.n_samples} sample(s) "
             f"(of {run.n_raw} read) but --window {settings.appraiser.window} with "
-            f"--parameters-size {settings.appraiser.parameters_size} needs at least {needed}; "
+            f"--order {settings.appraiser.order} needs at least {needed}; "
             "use a smaller --window or a longer record."
         )
 
