@@ -13,6 +13,7 @@ from typing import Any
 
 import click
 
+from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
 from clpc.workflows import AppraiserSettings, RecordSpec
 
 __all__ = [
@@ -135,7 +136,11 @@ def dt_option() -> Decorator:
 
 
 def sampling_options() -> Decorator:
-    """``--dt`` and ``--time COL`` (into ``time_col``)."""
+    """The sampling options of a record read from a file.
+
+    ``--dt``, ``--time COL`` (into ``time_col``), ``--time-unit``, ``--time-rtol``,
+    ``--resample`` and ``--skip-rows``.
+    """
     return combine(
         dt_option(),
         click.option(
@@ -143,7 +148,34 @@ def sampling_options() -> Decorator:
             "time_col",
             metavar="COL",
             default=None,
-            help="Column of sample times [s]; must be uniformly spaced.",
+            help="Column of sample times; dt is its mean step (steps uniform within --time-rtol).",
+        ),
+        click.option(
+            "--time-unit",
+            type=click.Choice(list(TIME_UNITS)),
+            default=None,
+            help="Unit of the --time column (default: from its name, e.g. t_ms is ms; else s).",
+        ),
+        click.option(
+            "--time-rtol",
+            type=click.FloatRange(min=0, min_open=True),
+            default=DEFAULT_TIME_RTOL,
+            show_default=True,
+            help="Largest relative deviation of one time step from the median step.",
+        ),
+        click.option(
+            "--resample",
+            is_flag=True,
+            help="Interpolate onto a uniform time grid instead of refusing a jittery --time "
+            "column (not for track).",
+        ),
+        click.option(
+            "--skip-rows",
+            type=click.IntRange(min=0),
+            default=0,
+            show_default=True,
+            help="Lines to skip at the top of a text file (a metadata line); a units row "
+            "under the header (s,m,V) is skipped without it.",
         ),
     )
 

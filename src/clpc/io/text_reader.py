@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from clpc.data import DataError
+from clpc.io.arrow_text import FallBack, arrow_batches, fast_path_applies
 from clpc.io.errors import cell_error, first_bad, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 from clpc.io.text_format import (
@@ -43,9 +44,15 @@ class TextReader:
         The sorted unique 0-based columns to read.
     allow_missing : bool
         Keep empty cells and NaN/inf as NaN instead of raising.
+    fast : bool
+        Use pyarrow when it is installed (default); ``False``: the plain reader only (the
+        reference of the tests and benchmarks).
     """
 
-    def __init__(self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool):
+    def __init__(
+        self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool, fast: bool = True
+    ):
+        self.fast = fast
         self.path = path
         self.source = show(path)
         self.fmt = fmt
@@ -54,7 +61,32 @@ class TextReader:
         self.allow_missing = allow_missing
 
     def batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time."""
+        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time.
+
+        Through pyarrow when it is installed and the file is plain (:mod:`clpc.io.arrow_text`;
+        its blocks are re-cut into ``chunk_rows`` rows), else, and from the first block the
+        fast path cannot vouch for, by the plain reader.
+        """
+        done = 0
+        if self.fast and fast_path_applies(self.path, self.fmt):
+            try:
+                for values, rows in rechunk(
+                    arrow_batches(self.path, self.fmt, self.use, self.allow_missing), chunk_rows
+                ):
+                    yield values, rows
+                    done += values.shape[0]
+                return
+            except FallBack:
+                pass
+        for values, rows in self.plain_batches(chunk_rows):
+            if done >= values.shape[0]:
+                done -= values.shape[0]
+                continue
+            yield values[done:], rows[done:]
+            done = 0
+
+    def plain_batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """As :meth:`batches`, always by the plain reader (``numpy.loadtxt`` and Python)."""
         with open_text(self.path) as f:
             try:
                 for _ in range(self.fmt.data_line - 1):
@@ -183,6 +215,8 @@ def text_source(
     delimiter: str | None,
     header: bool | None,
     allow_missing: bool,
+    skip_rows: int = 0,
+    fast: bool = True,
 ) -> tuple[list[str], Chunks]:
     """Names of the selected columns of a text file and a chunk generator over them.
 
@@ -190,8 +224,10 @@ def text_source(
     ----------
     path : Path
         An existing text data file.
-    columns, delimiter, header, allow_missing
+    columns, delimiter, header, allow_missing, skip_rows
         As for :func:`clpc.io.read_table`.
+    fast : bool
+        Use pyarrow when installed (see :class:`TextReader`).
 
     Returns
     -------
@@ -200,8 +236,30 @@ def text_source(
     chunks : Chunks
         ``chunks(chunk_rows)`` yields values and the 1-based line number of each row.
     """
-    fmt = sniff(path, delimiter, header)
+    fmt = sniff(path, delimiter, header, skip_rows)
     sel = resolve_columns(fmt.names, columns, show(path))
     use = sorted(set(sel))
-    reader = TextReader(path, fmt, use, allow_missing)
+    reader = TextReader(path, fmt, use, allow_missing, fast)
     return [fmt.names[i] for i in sel], reorder_columns(reader.batches, use, sel)
+
+
+def rechunk(
+    blocks: Iterator[tuple[np.ndarray, np.ndarray]], chunk_rows: int
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The rows of ``blocks`` re-cut into pieces of exactly ``chunk_rows`` (the last fewer)."""
+    values: list[np.ndarray] = []
+    rows: list[np.ndarray] = []
+    held = 0
+    for v, r in blocks:
+        values.append(v)
+        rows.append(r)
+        held += v.shape[0]
+        if held < chunk_rows:
+            continue
+        all_v, all_r = np.concatenate(values), np.concatenate(rows)
+        cut = held - held % chunk_rows
+        for lo in range(0, cut, chunk_rows):
+            yield all_v[lo : lo + chunk_rows], all_r[lo : lo + chunk_rows]
+        values, rows, held = [all_v[cut:]], [all_r[cut:]], held - cut
+    if held:
+        yield np.concatenate(values), np.concatenate(rows)

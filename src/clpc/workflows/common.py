@@ -16,6 +16,7 @@ from clpc.core.checks import (
     same_setting,
 )
 from clpc.data import IOData
+from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
 from clpc.io import load_iodata
 from clpc.model import LinearModel
 
@@ -108,7 +109,17 @@ class RecordSpec:
     dt : float, optional
         Sample time [s].
     time_col : str, optional
-        Column of sample times [s] (uniformly spaced).
+        Column of sample times (uniform within ``time_rtol``; see
+        :mod:`clpc.data.timebase`).
+    time_unit : {"s", "ms", "us"}, optional
+        Unit of ``time_col``; default the one its name says (``t_ms``), else seconds.
+    time_rtol : float
+        Largest relative deviation of one time step from the median step.
+    resample : bool
+        Interpolate onto a uniform grid instead of refusing a jittery time column (whole
+        records only: not for ``track``).
+    skip_rows : int
+        Text files: physical lines to pass over at the top (a metadata line).
     """
 
     file: str
@@ -116,9 +127,19 @@ class RecordSpec:
     outputs: tuple[str, ...] = ()
     dt: float | None = None
     time_col: str | None = None
+    time_unit: str | None = None
+    time_rtol: float = DEFAULT_TIME_RTOL
+    resample: bool = False
+    skip_rows: int = 0
 
     def __post_init__(self) -> None:
         _optional_positive(self.dt, "dt")
+        check_positive(self.time_rtol, "time_rtol")
+        check_int(self.skip_rows, "skip_rows", 0)
+        if self.time_unit is not None:
+            check_choice(self.time_unit, "time_unit", tuple(TIME_UNITS))
+        if self.resample and self.time_col is None:
+            raise SettingsError("resample needs a time column (--time COL).")
 
     def check_sampling(self) -> None:
         """Refuse a record given both ``dt`` and ``time_col``.
@@ -163,6 +184,10 @@ class RecordSpec:
             column_keys(self.outputs),
             dt=self.dt,
             time_column=column_key(self.time_col),
+            time_rtol=self.time_rtol,
+            time_unit=self.time_unit,
+            resample=self.resample,
+            skip_rows=self.skip_rows,
         )
 
 

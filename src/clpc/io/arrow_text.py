@@ -1,0 +1,148 @@
+"""The fast path for text data files: pyarrow's CSV reader, when pyarrow is installed.
+
+pyarrow parses a delimited file in C++ (several times faster than ``numpy.loadtxt``); the
+values are the same correctly rounded float64 numbers. The fast path only answers for files
+it can vouch for: a one-character delimiter, no compression, no blank lines (which would
+shift the line numbers), every selected cell a finite number (unless ``allow_missing``).
+Anything else - a comment line, a ragged row, a text cell, an empty cell, NaN - stops it,
+and :class:`~clpc.io.text_reader.TextReader` re-reads the file with the plain reader, which
+either handles the line (comments) or raises its one-line message naming the line, the
+column and the text. Without pyarrow the plain reader is used throughout.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import mmap
+import os
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from clpc.io.text_format import TextFormat
+
+__all__ = ["FallBack", "arrow_available", "arrow_batches", "fast_path_applies"]
+
+#: bytes per block of pyarrow's streaming reader
+BLOCK_BYTES = 1 << 22
+#: files up to this size are parsed whole (multi-threaded); larger ones block by block
+WHOLE_BYTES = 64 << 20
+
+
+class FallBack(Exception):
+    """The fast path cannot vouch for a block; the plain reader takes over from there."""
+
+
+def arrow_available() -> bool:
+    """Whether pyarrow can be imported and the fast path is not switched off.
+
+    ``CLPC_FAST_IO=0`` in the environment switches it off (the plain reader and writer
+    everywhere: what the benchmarks compare against).
+    """
+    if os.environ.get("CLPC_FAST_IO", "1") == "0":
+        return False
+    return importlib.util.find_spec("pyarrow") is not None
+
+
+def _has_blank_line(path: Path) -> bool:
+    """Whether the file holds an empty line, searched in C on a memory map."""
+    with open(path, "rb") as fh:
+        try:
+            with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+                return mm.find(b"\n\n") >= 0 or mm.find(b"\n\r\n") >= 0
+        except ValueError:  # an empty file cannot be mapped
+            return False
+
+
+def fast_path_applies(path: Path, fmt: TextFormat) -> bool:
+    """Whether the fast path may read ``path`` (pyarrow present, a plain delimited file)."""
+    return fmt.delimiter is not None and not path.name.lower().endswith(".gz") and arrow_available()
+
+
+def _whole(
+    csv: Any, pa: Any, path: Path, fmt: TextFormat, options: tuple[Any, ...], allow_missing: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The whole file parsed at once (several threads).
+
+    Raises :class:`FallBack` unless every line after the header is one row (no blank line,
+    no line pyarrow skipped).
+    """
+    data = path.read_bytes()
+    body = data.rstrip(b"\r\n")
+    n_lines = body.count(b"\n") + 1 if body else 0
+    table = csv.read_csv(
+        pa.BufferReader(data),
+        read_options=options[0],
+        parse_options=options[1],
+        convert_options=options[2],
+    )
+    n = table.num_rows
+    if n != n_lines - (fmt.data_line - 1):
+        raise FallBack
+    table = table.combine_chunks()
+    values = np.empty((n, table.num_columns))
+    for i in range(table.num_columns):
+        values[:, i] = _column(table, i, allow_missing)
+    if not allow_missing and not np.isfinite(values).all():
+        raise FallBack
+    return values, np.arange(fmt.data_line, fmt.data_line + n, dtype=np.int64)
+
+
+def _column(batch: Any, i: int, allow_missing: bool) -> np.ndarray:
+    """Column ``i`` of a record batch as float64; :class:`FallBack` on a null or NaN/inf."""
+    col = batch.column(i)
+    if col.null_count:
+        if not allow_missing:
+            raise FallBack
+        col = col.fill_null(float("nan"))
+    return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+
+
+def arrow_batches(
+    path: Path, fmt: TextFormat, use: list[int], allow_missing: bool
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Values ``(n, len(use))`` and 1-based line numbers of each block of the file.
+
+    Raises
+    ------
+    FallBack
+        A block the fast path cannot vouch for; the rows yielded before it are right.
+    """
+    import pyarrow as pa
+    from pyarrow import csv
+
+    names = [f"c{i}" for i in range(fmt.n_cols)]
+    wanted = [names[i] for i in use]
+    reader_options = csv.ReadOptions(
+        skip_rows=fmt.data_line - 1, column_names=names, block_size=BLOCK_BYTES
+    )
+    parse = csv.ParseOptions(delimiter=fmt.delimiter, quote_char='"')
+    convert = csv.ConvertOptions(
+        include_columns=wanted,
+        column_types=dict.fromkeys(wanted, pa.float64()),
+        null_values=[""],  # only an empty cell is missing, as for the plain reader
+        strings_can_be_null=False,
+    )
+    line = fmt.data_line
+    try:
+        if path.stat().st_size <= WHOLE_BYTES:
+            yield _whole(csv, pa, path, fmt, (reader_options, parse, convert), allow_missing)
+            return
+        if _has_blank_line(path):  # pyarrow would skip it and the line numbers would shift
+            raise FallBack
+        reader = csv.open_csv(
+            str(path), read_options=reader_options, parse_options=parse, convert_options=convert
+        )
+        for batch in reader:
+            n = batch.num_rows
+            if n == 0:
+                continue
+            values = np.column_stack([_column(batch, i, allow_missing) for i in range(len(use))])
+            if not allow_missing and not np.isfinite(values).all():
+                raise FallBack
+            yield values, np.arange(line, line + n, dtype=np.int64)
+            line += n
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError, pa.ArrowTypeError):
+        raise FallBack from None
