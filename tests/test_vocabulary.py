@@ -169,3 +169,23 @@ def test_track_progress_into_a_pipe_is_plain_lines(tmp_path, record):
         "tracking: 2000 of 3000 rows (67%)",
         "tracking: 3000 of 3000 rows (100%)",
     ]
+
+
+def test_integrating_is_not_unstable():
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(3000)
+    # voltage -> position: a pole at z = 1 and one at 0.7
+    y = clpc.simulate_arx([1, -1.7, 0.7], [0, 0.1, 0.05], u) + 1e-3 * rng.standard_normal(3000)
+    model = clpc.LPC(order=2, nk=1).fit(u, y, dt=0.01)
+    assert np.min(np.abs(model.poles() - 1.0)) < 1e-3
+    assert model.stability == "integrating" and not model.is_stable
+    assert "integrating (pole at z = 1)" in repr(model)
+    verdict = clpc.fit_verdict(model)
+    assert verdict.stability == "integrating" and "NOT stable" not in str(verdict)
+    assert "the model is integrating (pole at z = 1)" in str(verdict)
+    from clpc.core.polynomials import pole_class
+
+    assert pole_class(np.array([1.02, 0.5])) == "unstable"
+    assert pole_class(np.array([-1.0, 0.5])) == "marginal"
+    assert pole_class(np.array([0.99 + 0.0j, 0.5])) == "stable"
+    assert pole_class(np.array([0.998, 0.5])) == "integrating"

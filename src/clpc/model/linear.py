@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from clpc.core.polynomials import monic
+from clpc.core.polynomials import monic, pole_class, pole_words
 from clpc.model import simulation
 from clpc.model.errors import ModelError
 from clpc.model.structure import Structure
@@ -156,6 +156,17 @@ class LinearModel:
     def is_stable(self) -> bool:
         """All poles strictly inside the unit circle."""
         return all(np.all(np.abs(self.poles(j)) < 1.0) for j in range(self.n_outputs))
+
+    @property
+    def stability(self) -> str:
+        """``"stable"``, ``"integrating"`` (a pole at z = 1), ``"marginal"`` or ``"unstable"``.
+
+        The worst over the outputs (:func:`clpc.core.polynomials.pole_class`); an integrator
+        (voltage -> position) is ``"integrating"``, not ``"unstable"``.
+        """
+        order = ("stable", "marginal", "integrating", "unstable")
+        kinds = [pole_class(self.poles(j)) for j in range(self.n_outputs)]
+        return max(kinds, key=order.index)
 
     def dc_gain(self) -> np.ndarray:
         """Static gains ``G(1)``, shape (n_outputs, n_inputs).
@@ -323,9 +334,16 @@ class LinearModel:
             return control.TransferFunction(nums[0][0], dens[0][0], self.dt)
         return control.TransferFunction(nums, dens, self.dt)
 
+    def _stability_words(self) -> str:
+        try:
+            return pole_words(self.stability)
+        except (ValueError, np.linalg.LinAlgError):  # no poles (a0 = 0)
+            return "no poles"
+
     def __repr__(self) -> str:
         s = self.structure
         return (
             f"LinearModel(na={s.na}, nb={s.nb}, nk={s.nk}, inputs={self.n_inputs}, "
-            f"outputs={self.n_outputs}, mode={self.mode!r}, dt={self.dt:g})"
+            f"outputs={self.n_outputs}, mode={self.mode!r}, dt={self.dt:g}, "
+            f"{self._stability_words()})"
         )

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.polynomials import pole_class, pole_words
+
 __all__ = ["Verdict", "describe_trace", "fit_verdict"]
 
 
@@ -35,6 +37,9 @@ class Verdict:
         The input order the excitation was checked for (``nb + 1`` lags).
     messages : tuple of str
         Plain-language findings.
+    stability : str
+        ``"stable"``, ``"integrating"`` (a pole at z = 1: an integrator, not a failure),
+        ``"marginal"`` or ``"unstable"`` (:func:`clpc.core.polynomials.pole_class`).
     """
 
     n_null: int
@@ -43,6 +48,7 @@ class Verdict:
     stable: bool
     order: int
     messages: tuple[str, ...]
+    stability: str = "stable"
 
     def __str__(self) -> str:
         return "; ".join(self.messages)
@@ -51,24 +57,14 @@ class Verdict:
 def fit_verdict(model: Any, output: int = 0) -> Verdict:
     """The verdict of an LPC fit (:meth:`clpc.LPC.fit`) for one output."""
     info = model.info
+    stable, kind, words = _stability(model, output)
     if "n_null" not in info:  # e.g. a CLPC steady-state model: no single fit behind it
-        try:
-            stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
-        except ValueError:
-            stable = False
-        notes = (
-            "no fit statistics (an averaged or loaded model)",
-            "the model is stable" if stable else "the model is NOT stable",
-        )
-        return Verdict(0, True, False, stable, model.structure.nb + 1, notes)
+        notes = ("no fit statistics (an averaged or loaded model)", f"the model is {words}")
+        return Verdict(0, True, False, stable, model.structure.nb + 1, notes, kind)
     n_null = int(np.asarray(info["n_null"])[output])
     n_input = int(np.asarray(info["n_input_relations"])[output])
     determined = bool(np.asarray(info["determined"])[output])
     sep = float(np.asarray(info["separation"])[output])
-    try:
-        stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
-    except ValueError:
-        stable = False
     order = model.structure.nb + 1
     msgs = []
     if n_input:
@@ -98,8 +94,18 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             f"the parameters are poorly determined (smallest eigenvalue {sep:.2g} of the next):"
             " the data hardly prefer this model to others"
         )
-    msgs.append("the model is stable" if stable else "the model is NOT stable")
-    return Verdict(n_null, n_input == 0, determined, stable, order, tuple(msgs))
+    msgs.append(f"the model is {words}")
+    return Verdict(n_null, n_input == 0, determined, stable, order, tuple(msgs), kind)
+
+
+def _stability(model: Any, output: int) -> tuple[bool, str, str]:
+    """Strictly stable; the pole class; its words (``"integrating (pole at z = 1)"``)."""
+    try:
+        poles = model.poles(output)
+    except ValueError:
+        return False, "unstable", "NOT stable (no poles)"
+    kind = pole_class(poles)
+    return bool(np.all(np.abs(poles) < 1.0)), kind, pole_words(kind)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
