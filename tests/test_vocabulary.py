@@ -189,3 +189,35 @@ def test_integrating_is_not_unstable():
     assert pole_class(np.array([-1.0, 0.5])) == "marginal"
     assert pole_class(np.array([0.99 + 0.0j, 0.5])) == "stable"
     assert pole_class(np.array([0.998, 0.5])) == "integrating"
+
+
+def test_identify_na_nb(tmp_path, record):
+    u, y = record
+    path = tmp_path / "r.csv"
+    write_table(path, ["u", "y"], np.column_stack([u, y]))
+    res = _run(
+        "identify", path, "-u", "u", "-y", "y", "--na", "2", "--nb", "1", "--nk", "1", "--json"
+    )
+    assert res.exit_code == 0, res.output
+    ref = clpc.LPC(na=2, nb=1, nk=1).fit(u, y)
+    assert '"na": 2, "nb": 1, "nk": 1' in res.output
+    assert "MATLAB" in _run("identify", "--help").output
+    assert ref.num.size == 3  # nk = 1 leading zero, then nb + 1 = 2 coefficients
+    bad = _run("identify", path, "-u", "u", "-y", "y", "--order", "auto", "--na", "2")
+    assert bad.exit_code == 2 and "order auto" in bad.output
+
+
+def test_compare_exits_1_when_the_response_diverges(tmp_path):
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal(200)
+    y = clpc.simulate_arx([1, -1.05], [0, 0.5], u)  # an unstable plant, short record
+    model = clpc.ARX(order=1, nk=1).fit(u, y, dt=1.0)
+    assert model.stability == "unstable"
+    model_file = tmp_path / "m.json"
+    clpc.save_model(model, model_file)
+    long_u = rng.standard_normal(20000)
+    path = tmp_path / "long.csv"
+    write_table(path, ["u", "y"], np.column_stack([long_u, long_u]))
+    res = _run("compare", model_file, path, "-u", "u", "-y", "y")
+    assert res.exit_code == 1
+    assert "n/a (diverges)" in res.stdout and "diverges on this record" in res.stderr

@@ -70,6 +70,19 @@ def _selection_line(result: IdentifyResult) -> str:
     "and the k-step prediction fit (k: one dominant time constant), unstable orders "
     "rejected (validation); BIC, AIC or the paper's Remark 1.",
 )
+@click.option(
+    "--na",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Output order (A has na + 1 coefficients); overrides --order for A.",
+)
+@click.option(
+    "--nb",
+    type=click.IntRange(min=0),
+    default=None,
+    help="Input order (each B has nb + 1 coefficients: MATLAB's arx nb is this + 1); "
+    "overrides --order for B.",
+)
 @nk_option()
 @method_option()
 @click.option(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from clpc.cli.errors import ClpcCommand
@@ -93,7 +95,8 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
 
     The first max-lag samples give the initial conditions; the fit % (100 = perfect,
     0 = as good as the mean) is computed over the rest. Data whose --dt or --time says
-    they are sampled at another rate than the model's are refused.
+    they are sampled at another rate than the model's are refused; a response that diverges
+    exits 1.
 
     \b
     Examples:
@@ -101,8 +104,10 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
       clpc compare model.json validation.csv -u uVal -y yVal --k 10 --plot cmp.png
     """  # noqa: D301
     result = compare_file(settings)
+    diverged = [name for name, fit in result.fit.items() if fit is None]
     if as_json:
         echo_json(result.to_dict())
+        _exit_if_diverged(diverged, result.compared)
         return
     last = result.n_samples - 1
     for name, fit in result.fit.items():
@@ -112,3 +117,15 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
         )
     if result.plot:
         click.echo(f"wrote {result.plot}")
+    _exit_if_diverged(diverged, result.compared)
+
+
+def _exit_if_diverged(names: list[str], compared: str) -> None:
+    """A comparison whose response diverges failed: say so and exit 1."""
+    if names:
+        click.echo(
+            f"Error: the model's {compared} diverges on this record (output(s) {names}): "
+            "there is no fit to report.",
+            err=True,
+        )
+        sys.exit(1)

@@ -204,7 +204,8 @@ def nk_option() -> Decorator:
         type=click.IntRange(min=0),
         default=0,
         show_default=True,
-        help="Input delay in samples.",
+        help="Input delay in samples (0: b0 acts at once, as in the paper; a physical plant "
+        "with no direct feed-through has nk >= 1, as MATLAB's default).",
     )
 
 

@@ -14,7 +14,7 @@ from clpc.io import save_model
 from clpc.lpc import LPC, OrderSelection, select_order
 from clpc.model import LinearModel, MimoMode
 from clpc.report import model_summary
-from clpc.workflows.common import METHODS, Method, RecordSpec
+from clpc.workflows.common import METHODS, Method, RecordSpec, SettingsError
 
 __all__ = ["IdentifyResult", "IdentifySettings", "identify_file"]
 
@@ -45,6 +45,9 @@ class IdentifySettings:
         Multi-channel structure.
     save : str, optional
         Save the model to this JSON file.
+    na, nb : int, optional
+        Separate output / input orders overriding ``order`` (clpc's meaning: ``nb + 1``
+        coefficients per input; MATLAB's ``arx`` nb is clpc's ``nb + 1``).
     """
 
     record: RecordSpec
@@ -55,6 +58,8 @@ class IdentifySettings:
     method: Method = "robust"
     mimo: MimoMode | None = None
     save: str | None = None
+    na: int | None = None
+    nb: int | None = None
 
     def __post_init__(self) -> None:
         if self.order != "auto":
@@ -63,6 +68,11 @@ class IdentifySettings:
         check_choice(self.criterion, "criterion", CRITERIA)
         check_int(self.nk, "nk", 0)
         check_choice(self.method, "method", METHODS)
+        for name in ("na", "nb"):
+            if getattr(self, name) is not None:
+                check_int(getattr(self, name), name, 0 if name == "nb" else 1)
+        if self.order == "auto" and (self.na is not None or self.nb is not None):
+            raise SettingsError("order auto chooses na = nb = N; do not also give na or nb.")
 
 
 @dataclass(frozen=True)
@@ -128,7 +138,9 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
         Unreadable record; data that do not determine a model.
     """
     data = settings.record.load()
-    estimator = LPC(nk=settings.nk, method=settings.method, mimo=settings.mimo)
+    estimator = LPC(
+        nk=settings.nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
+    )
     selection = None
     order = settings.order
     if order == "auto":
