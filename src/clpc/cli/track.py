@@ -34,7 +34,7 @@ from clpc.workflows import (
 __all__ = ["track"]
 
 
-def _progress_bar(file: str) -> ChunkFilter:
+def _progress_bar(file: str, skip_rows: int = 0) -> ChunkFilter:
     """Chunks passed on under a progress bar on standard error (rows of ``file``).
 
     On a terminal: click's bar; into a pipe or a file: one plain line per chunk
@@ -42,7 +42,7 @@ def _progress_bar(file: str) -> ChunkFilter:
     """
 
     def show(chunks: Iterator[Chunk]) -> Iterator[Chunk]:
-        length = count_data_lines(file) or 0
+        length = count_data_lines(file, skip_rows) or 0
         if not sys.stderr.isatty():
             done = 0
             for names, values in chunks:
@@ -122,7 +122,8 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
       clpc track big.parquet -u u -y y --dt 0.001 --decimate-to 0.01 --out run2/ --progress
     """  # noqa: D301
     show = progress if progress is not None else sys.stderr.isatty()
-    result = track_file(settings, _progress_bar(settings.record.file) if show else None)
+    bar = _progress_bar(settings.record.file, settings.record.skip_rows) if show else None
+    result = track_file(settings, bar)
     _print_result(result)
     if settings.save and result.model is None:
         click.echo("Error: no update was accepted: there is no model to save", err=True)

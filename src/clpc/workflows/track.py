@@ -16,6 +16,7 @@ from clpc.core.checks import check_choice, check_int
 from clpc.data import DataError
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
+from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
@@ -85,13 +86,15 @@ class TrackResult:
     files: list[Path]
 
 
-def count_data_lines(path: str) -> int | None:
-    """Data lines of an uncompressed text file (one header line assumed), else ``None``.
+def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
+    """Lines after the header (and a units row) of an uncompressed text file, else ``None``.
 
     Parameters
     ----------
     path : str
         A data file; only csv, tsv, tab, txt and dat files are counted.
+    skip_rows : int
+        Lines passed over at the top (see :func:`clpc.io.read_table`).
 
     Returns
     -------
@@ -105,7 +108,11 @@ def count_data_lines(path: str) -> int | None:
     with p.open("rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             lines += block.count(b"\n")
-    return max(lines - 1, 1)
+    try:
+        before = sniff(p, None, None, skip_rows).data_line - 1  # header, units, skipped
+    except DataError:
+        before = 1 + skip_rows
+    return max(lines - before, 1)
 
 
 class _Clock:
