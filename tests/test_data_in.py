@@ -199,3 +199,14 @@ def test_trace_csv_has_integers_as_integers(tmp_path, monkeypatch, fast_io):
     ref_names, ref = trace_columns(trace)
     assert table.names == ref_names
     np.testing.assert_array_equal(table.data, ref)
+
+
+@pytest.mark.parametrize("text", ["a,b\n1,2\n\n3,4\n5,6\n", "a,b\n1,2\n3,4\n5,6\n\n\n"])
+def test_blank_lines_keep_the_line_numbers(tmp_path, text):
+    path = tmp_path / "blank.csv"
+    path.write_text(text)
+    fast, plain = read_table(path), read_table(path, fast=False)
+    np.testing.assert_array_equal(fast.data, [[1, 2], [3, 4], [5, 6]])
+    labels = [fast.row_label(i) for i in range(3)]
+    assert labels == [plain.row_label(i) for i in range(3)]
+    assert labels[1] == ("line 4" if "\n\n3" in text else "line 3")

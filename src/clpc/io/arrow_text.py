@@ -2,8 +2,9 @@
 
 pyarrow parses a delimited file in C++ (several times faster than ``numpy.loadtxt``); the
 values are the same correctly rounded float64 numbers. The fast path only answers for files
-it can vouch for: a one-character delimiter, no compression, no blank lines (which would
-shift the line numbers), every selected cell a finite number (unless ``allow_missing``).
+it can vouch for: a one-character delimiter, two columns or more, no compression, no blank
+line (read as a row here, so that the line numbers stay exact), every selected cell a finite
+number (unless ``allow_missing``).
 Anything else - a comment line, a ragged row, a text cell, an empty cell, NaN - stops it,
 and :class:`~clpc.io.text_reader.TextReader` re-reads the file with the plain reader, which
 either handles the line (comments) or raises its one-line message naming the line, the
@@ -13,7 +14,6 @@ column and the text. Without pyarrow the plain reader is used throughout.
 from __future__ import annotations
 
 import importlib.util
-import mmap
 import os
 from collections.abc import Iterator
 from pathlib import Path
@@ -46,42 +46,19 @@ def arrow_available() -> bool:
     return importlib.util.find_spec("pyarrow") is not None
 
 
-def _has_blank_line(path: Path) -> bool:
-    """Whether the file holds an empty line, searched in C on a memory map."""
-    with open(path, "rb") as fh:
-        try:
-            with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
-                return mm.find(b"\n\n") >= 0 or mm.find(b"\n\r\n") >= 0
-        except ValueError:  # an empty file cannot be mapped
-            return False
-
-
 def fast_path_applies(path: Path, fmt: TextFormat) -> bool:
     """Whether the fast path may read ``path`` (pyarrow present, a plain delimited file)."""
     return fmt.delimiter is not None and not path.name.lower().endswith(".gz") and arrow_available()
 
 
 def _whole(
-    csv: Any, pa: Any, path: Path, fmt: TextFormat, options: tuple[Any, ...], allow_missing: bool
+    csv: Any, path: Path, fmt: TextFormat, options: tuple[Any, ...], allow_missing: bool
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The whole file parsed at once (several threads).
-
-    Raises :class:`FallBack` unless every line after the header is one row (no blank line,
-    no line pyarrow skipped).
-    """
-    data = path.read_bytes()
-    body = data.rstrip(b"\r\n")
-    n_lines = body.count(b"\n") + 1 if body else 0
+    """The whole file parsed at once (several threads)."""
     table = csv.read_csv(
-        pa.BufferReader(data),
-        read_options=options[0],
-        parse_options=options[1],
-        convert_options=options[2],
-    )
+        str(path), read_options=options[0], parse_options=options[1], convert_options=options[2]
+    ).combine_chunks()
     n = table.num_rows
-    if n != n_lines - (fmt.data_line - 1):
-        raise FallBack
-    table = table.combine_chunks()
     values = np.empty((n, table.num_columns))
     for i in range(table.num_columns):
         values[:, i] = _column(table, i, allow_missing)
@@ -118,7 +95,9 @@ def arrow_batches(
     reader_options = csv.ReadOptions(
         skip_rows=fmt.data_line - 1, column_names=names, block_size=BLOCK_BYTES
     )
-    parse = csv.ParseOptions(delimiter=fmt.delimiter, quote_char='"')
+    # a blank line is a row here (one empty field: an error), so that pyarrow's rows are
+    # the file's lines one for one and the line numbers stay exact
+    parse = csv.ParseOptions(delimiter=fmt.delimiter, quote_char='"', ignore_empty_lines=False)
     convert = csv.ConvertOptions(
         include_columns=wanted,
         column_types=dict.fromkeys(wanted, pa.float64()),
@@ -128,10 +107,8 @@ def arrow_batches(
     line = fmt.data_line
     try:
         if path.stat().st_size <= WHOLE_BYTES:
-            yield _whole(csv, pa, path, fmt, (reader_options, parse, convert), allow_missing)
+            yield _whole(csv, path, fmt, (reader_options, parse, convert), allow_missing)
             return
-        if _has_blank_line(path):  # pyarrow would skip it and the line numbers would shift
-            raise FallBack
         reader = csv.open_csv(
             str(path), read_options=reader_options, parse_options=parse, convert_options=convert
         )

@@ -256,7 +256,8 @@ def rechunk(
         held += v.shape[0]
         if held < chunk_rows:
             continue
-        all_v, all_r = np.concatenate(values), np.concatenate(rows)
+        all_v = values[0] if len(values) == 1 else np.concatenate(values)
+        all_r = rows[0] if len(rows) == 1 else np.concatenate(rows)
         cut = held - held % chunk_rows
         for lo in range(0, cut, chunk_rows):
             yield all_v[lo : lo + chunk_rows], all_r[lo : lo + chunk_rows]
