@@ -2,7 +2,7 @@
 
 Semantics (``docs/clpc.md`` says the same):
 
-* Samples are numbered ``k = 0, 1, 2, ...`` (after decimation to ``sample_time``). The lag
+* Samples are numbered ``k = 0, 1, 2, ...`` (after decimation to ``decimate_to``). The lag
   vector ``z_k`` exists once ``k >= max_lag`` (``max_lag = N`` for the paper's structure).
 * ``window_size`` ``W`` is the number of lag vectors (rows of M, eq. 36) in one LPC.
   The counter counts lag vectors; each time it reaches ``cluster_size`` ``C`` (the
@@ -18,9 +18,11 @@ Semantics (``docs/clpc.md`` says the same):
   above its quantization, a solution the data determine (see :mod:`clpc.core.rules`). An
   update that is not accepted holds the last accepted parameters; parameters are never NaN
   (zeros, with ``has_model=False``, until a first estimate is accepted).
-* ``sample_time``: data sampled faster by an integer factor are low-pass filtered (causal
-  4th-order Butterworth at 0.8 of the new Nyquist frequency, filter state carried across
-  chunks) and every factor-th sample is kept (samples ``0, f, 2f, ...``).
+* ``decimate_to``: data sampled (``dt``) faster by an integer factor are low-pass filtered
+  (causal 4th-order Butterworth at 0.8 of the new Nyquist frequency, filter state carried
+  across chunks) and every factor-th sample is kept (samples ``0, f, 2f, ...``). The former
+  ``sample_time`` named either ``dt`` or ``decimate_to`` depending on the data; it still works
+  and warns (``DeprecationWarning``) whenever it had to pick.
 
 The state (the last window of samples, the counter, the last parameters, the filter state) is
 the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` serialise it.
