@@ -119,3 +119,10 @@ def test_frames_round_trip(two):
     np.testing.assert_array_equal(back.y, both.y)
     with pytest.raises(DataError, match=r"columns \['v'\]"):
         IOData.from_frame(frame, "v", "y")
+
+
+def test_clpc_refuses_a_record_of_several_experiments(two):
+    with pytest.raises(DataError, match=r"IOData\.split"):
+        clpc.CLPC(order=2, window_size=101).run(list(two))
+    part = IOData.concat(list(two)).split()[0]
+    assert len(clpc.CLPC(order=2, window_size=101).run(part)) > 0

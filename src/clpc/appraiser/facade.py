@@ -428,6 +428,12 @@ class CLPC:
             fsm.init_channels(self, u_arr.shape[1], y_arr.shape[1])
         else:
             data = as_iodata(u, y, dt)
+            if data.n_experiments > 1:
+                raise DataError(
+                    f"CLPC runs over one continuous record; this one holds "
+                    f"{data.n_experiments} experiments, and its windows would reach across "
+                    "their boundaries. Run each experiment on its own (IOData.split())."
+                )
             u_arr, y_arr = data.u, data.y
             given_dt = isinstance(u, IOData) or dt is not None
             data_dt = data.dt if given_dt else None  # arrays without dt: at sample_time
