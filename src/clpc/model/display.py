@@ -94,6 +94,12 @@ def _equations(model: Any) -> list[dict[str, Any]]:
     return eqs
 
 
+def _poly_html(text: str) -> str:
+    """A polynomial for HTML: each term kept on one line (no break inside ``z^-1``)."""
+    terms = text.replace(" + ", "\0+ ").replace(" - ", "\0- ").split("\0")
+    return " ".join(f'<span style="white-space:nowrap">{html.escape(t)}</span>' for t in terms)
+
+
 def _stat_text(key: str, value: Any) -> str:
     return f"{key}={value}" if isinstance(value, bool) else f"{key}={value:.4g}"
 
@@ -138,14 +144,19 @@ def model_html(model: Any) -> str:
     eqs = _equations(model)
     rows = []
     for eq in eqs:
-        poles = ", ".join(f"{p.real:.4g}" if p.imag == 0 else f"{p:.4g}" for p in eq["poles"])
+        poles = ", ".join(
+            f'<span style="white-space:nowrap">{p.real:.4g}</span>'
+            if p.imag == 0
+            else f'<span style="white-space:nowrap">{p:.4g}</span>'
+            for p in eq["poles"]
+        )
         stable = bool(np.all(np.abs(eq["poles"]) < 1.0))
-        stats = "<br>".join(esc(_stat_text(k, v)) for k, v in eq["stats"].items())
+        stats = "<br>".join(esc(_stat_text(k, v)) for k, v in eq["stats"].items()) or "&ndash;"
         for inp, num in eq["num"].items():
             rows.append(
-                f"<tr><td>{esc(inp)} &rarr; {esc(eq['output'])}</td><td>{esc(num)}</td>"
-                f"<td>{esc(eq['den'])}</td><td>{eq['offset']:.6g}</td>"
-                f"<td>{esc(poles)}</td><td>{'yes' if stable else '<b>NO</b>'}</td>"
+                f"<tr><td>{esc(inp)} &rarr; {esc(eq['output'])}</td><td>{_poly_html(num)}</td>"
+                f"<td>{_poly_html(eq['den'])}</td><td>{eq['offset']:.6g}</td>"
+                f"<td>{poles}</td><td>{'yes' if stable else '<b>NO</b>'}</td>"
                 f"<td>{stats}</td></tr>"
             )
     head = (
