@@ -136,4 +136,6 @@ def settings_section(settings: Mapping[str, Any]) -> Section:
                 flat[f"{prefix}{k}"] = v
 
     add("", settings)
+    if not flat:
+        return Section("Settings", text="No settings were recorded.", collapsed=True)
     return Section("Settings", table=flat, collapsed=True)
