@@ -140,7 +140,9 @@ def draw_signal(ax: Any, x: Any, y: Any, *, color: str, label: str | None = None
     xb, lo, hi = envelope(x, y)
     if lo is hi:
         return ax.plot(xb, lo, color=color, label=label, lw=kw.pop("lw", 1.0), **kw)
-    return ax.fill_between(xb, lo, hi, color=color, alpha=0.55, lw=0, label=label, step="post")
+    return ax.fill_between(
+        xb, lo, hi, facecolor=color, edgecolor=color, alpha=0.8, lw=0.4, label=label, step="post"
+    )
 
 
 def time_label(dt: float | None) -> str:

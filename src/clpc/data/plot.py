@@ -14,6 +14,7 @@ def plot_iodata(
     data: Any,
     path: str | PathLike[str] | None = None,
     *,
+    t0: float = 0.0,
     title: str | None = None,
     ax: Any = None,
 ) -> Any:
@@ -24,6 +25,8 @@ def plot_iodata(
     data : IOData
     path : str or path-like, optional
         Also write the figure as PNG here (parent folders are created).
+    t0 : float
+        Time of the first sample [s, or samples without a sample time].
     title : str, optional
         Figure title (default: the sample count and sample time).
     ax : sequence of matplotlib Axes, optional
@@ -37,7 +40,7 @@ def plot_iodata(
     """
     names = [*data.input_names, *data.output_names]
     fig, axes = axes_for(ax, len(names), height=1.6)
-    t = data.time
+    t = t0 + data.time
     for k, name in enumerate(names):
         is_input = k < data.n_inputs
         values = data.u[:, k] if is_input else data.y[:, k - data.n_inputs]

@@ -16,6 +16,8 @@ import numpy as np
 
 __all__ = ["model_html", "model_repr", "poly_text", "squeeze_info"]
 
+_NOWRAP = 'style="white-space:nowrap"'
+
 #: statistics shown beside each equation (when the model has them)
 SHOWN_STATS = ("D", "lambda_min", "noise_variance", "determined")
 
@@ -151,13 +153,15 @@ def model_html(model: Any) -> str:
             for p in eq["poles"]
         )
         stable = bool(np.all(np.abs(eq["poles"]) < 1.0))
-        stats = "<br>".join(esc(_stat_text(k, v)) for k, v in eq["stats"].items()) or "&ndash;"
+        stats = "<br>".join(
+            f"<span {_NOWRAP}>{esc(_stat_text(k, v))}</span>" for k, v in eq["stats"].items()
+        )
         for inp, num in eq["num"].items():
             rows.append(
                 f"<tr><td>{esc(inp)} &rarr; {esc(eq['output'])}</td><td>{_poly_html(num)}</td>"
-                f"<td>{_poly_html(eq['den'])}</td><td>{eq['offset']:.6g}</td>"
+                f"<td>{_poly_html(eq['den'])}</td><td {_NOWRAP}>{eq['offset']:.6g}</td>"
                 f"<td>{poles}</td><td>{'yes' if stable else '<b>NO</b>'}</td>"
-                f"<td>{stats}</td></tr>"
+                f"<td>{stats or '&ndash;'}</td></tr>"
             )
     head = (
         "<tr><th>channel</th><th>B(z)</th><th>A(z)</th><th>offset</th><th>poles</th>"

@@ -97,6 +97,7 @@ def plot_fit(
     path: str | PathLike[str] | None = None,
     *,
     k: int | None = None,
+    t0: float = 0.0,
     title: str | None = None,
     ax: Any = None,
 ) -> Any:
@@ -112,6 +113,9 @@ def plot_fit(
     k : int, optional
         ``None``: the free-run simulation; else the ``k``-step prediction
         (:func:`clpc.report.model_response`).
+    t0 : float
+        Time of ``data``'s first sample [s, or samples without a sample time], e.g. when
+        it is the end of a longer record.
     title : str, optional
     ax : sequence of matplotlib Axes, optional
         ``2 * n_outputs`` axes (output, residual per output); default: a new figure.
@@ -127,7 +131,7 @@ def plot_fit(
     y_hat, start, fit = model_response(model, data.u, data.y, k)
     what = "simulation" if k is None else f"{k}-step prediction"
     fig, axes = axes_for(ax, 2 * data.n_outputs, height=1.9)
-    t = data.time[start:]
+    t = t0 + data.time[start:]
     color = COLORS["model" if k is None else "prediction"]
     for j, name in enumerate(data.output_names):
         a_y, a_r = axes[2 * j], axes[2 * j + 1]

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from clpc.model import LinearModel, fit_verdict
-from clpc.plotting import plot_bode, plot_fit, plot_pz, plot_step
+from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
 from clpc.report.html import Section
 from clpc.report.summaries import model_summary
 from clpc.report.text import format_fit, format_model_summary
@@ -53,6 +53,7 @@ def model_sections(
     *,
     data: Any = None,
     data_note: str = "",
+    data_t0: float = 0.0,
 ) -> tuple[list[Section], list[Path]]:
     """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
 
@@ -66,6 +67,8 @@ def model_sections(
         Record to compare the model with (the fit figures are left out without it).
     data_note : str
         Where the compared samples come from (shown under the fit figure).
+    data_t0 : float
+        Time of ``data``'s first sample in the whole record (the fit figure's time axis).
 
     Returns
     -------
@@ -84,8 +87,8 @@ def model_sections(
     ]
     if data is not None:
         fit_png, data_png = out / "fit.png", out / "data.png"
-        plot_fit(model, data, fit_png)
-        data.plot(data_png, title=f"record: {data.n_samples} samples")
+        plot_fit(model, data, fit_png, t0=data_t0)
+        plot_data(data, data_png, t0=data_t0, title=f"the compared {data.n_samples} samples")
         files += [fit_png, data_png]
         sections.append(
             Section(

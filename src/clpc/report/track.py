@@ -83,6 +83,7 @@ def write_track_report(
     summary: Mapping[str, Any] | None = None,
     data: Any = None,
     data_note: str = "",
+    data_t0: float = 0.0,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -103,7 +104,9 @@ def write_track_report(
     data : IOData, optional
         Measured record (at the trace's sample time) to compare the model with.
     data_note : str
-        Where ``data`` comes from (e.g. "the last 20000 samples of the record").
+        Where ``data`` comes from (e.g. "the last 4000 samples of the record").
+    data_t0 : float
+        Time of ``data``'s first sample in the record (the fit figure's time axis).
 
     Returns
     -------
@@ -126,7 +129,7 @@ def write_track_report(
     sections = [result]
     files: list[Path] = []
     if model is not None:
-        more, files = model_sections(model, out, data=data, data_note=data_note)
+        more, files = model_sections(model, out, data=data, data_note=data_note, data_t0=data_t0)
         more[0].heading = f"Model ({source})"
         sections += more
     else:

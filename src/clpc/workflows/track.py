@@ -14,6 +14,7 @@ from clpc.appraiser import CLPC
 from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
+from clpc.core.figure import MAX_POINTS
 from clpc.data import DataError, IOData
 from clpc.io import iter_table_chunks, save_model
 from clpc.model import LinearModel
@@ -139,7 +140,8 @@ class _Clock:
 
 
 #: the report compares the model with at most this many (decimated) samples at the end
-REPORT_SAMPLES = 20_000
+#: (its figure then draws every sample: see :data:`clpc.core.figure.MAX_POINTS`)
+REPORT_SAMPLES = MAX_POINTS
 
 
 class _Tail:
@@ -238,7 +240,8 @@ def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
         "a free-run simulation that starts from the first measured samples and then uses "
         "the input alone."
     )
-    return {"data": data, "data_note": note}
+    t0 = (n - rows.shape[0]) * trace.sample_time
+    return {"data": data, "data_note": note, "data_t0": t0}
 
 
 def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
