@@ -128,7 +128,7 @@ def test_track_report_parses_and_reads_top_down(track_report):
         for p in (
             "CLPC track report",
             "Result",
-            "Model (steady state)",
+            "Model: steady state",
             "Measured data, model output and residuals",
             "Step and frequency response",
             "Trace",

@@ -17,7 +17,22 @@ plot_data = plot_iodata
 
 
 def _fit_text(fit: float) -> str:
-    return "n/a (diverges)" if not np.isfinite(fit) else f"{fit:.1f} %"
+    return "n/a: diverges" if not np.isfinite(fit) else f"{fit:.1f} %"
+
+
+def _keep_to_measured(ax_y: Any, ax_r: Any, meas: np.ndarray, modelled: np.ndarray) -> None:
+    """A diverging model output: limit both panels to the measured range and say so."""
+    lo, hi = float(np.min(meas)), float(np.max(meas))
+    span = max(hi - lo, 1e-12)
+    with np.errstate(invalid="ignore"):
+        inside = np.abs(modelled - 0.5 * (lo + hi)) <= 10 * span
+    if np.all(inside):
+        return
+    ax_y.set_ylim(lo - 0.5 * span, hi + 0.5 * span)
+    ax_r.set_ylim(-1.5 * span, 1.5 * span)
+    note = "the model output leaves this range (diverges)"
+    ax_y.text(0.99, 0.03, note, ha="right", va="bottom", transform=ax_y.transAxes,
+              fontsize="small", color=COLORS["residual"])  # fmt: skip
 
 
 def _dt_of(t: np.ndarray) -> float | None:
@@ -143,8 +158,15 @@ def plot_fit(
         with np.errstate(over="ignore", invalid="ignore"):
             resid = meas - modelled
             rms = float(np.sqrt(np.mean(resid**2)))
-        draw_signal(a_r, t, resid, color=COLORS["residual"], label=f"residual (RMS {rms:.3g})")
+        draw_signal(
+            a_r,
+            t,
+            resid,
+            color=COLORS["residual"],
+            label=f"residual (RMS {rms:.3g})" if np.isfinite(rms) else "residual (diverges)",
+        )
         a_r.axhline(0.0, color="0.5", lw=0.8)
+        _keep_to_measured(a_y, a_r, meas, modelled)
         a_r.set_ylabel(f"{name} − model\n[data units]")
         place_legend(a_r)
         for a in (a_y, a_r):

@@ -138,6 +138,11 @@ def plot_trace(
             axp.set_ylabel(f"{lab} [-]" if n_eq == 1 else f"{lab} ({name}) [-]")
             axp.set_xlabel(xlabel)
             axp.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useOffset=False)
+            if t.size > 1:
+                axp.set_xlim(t[0], t[-1])
+            if not has.any():
+                axp.text(0.5, 0.5, "no estimate accepted", transform=axp.transAxes,
+                         ha="center", va="center", color="0.4")  # fmt: skip
     for a in axes:
         a.grid(True, alpha=0.3)
     heading = title or f"CLPC trace: {len(trace)} updates"

@@ -43,9 +43,11 @@ def trace_warnings(trace: Trace, summary: Mapping[str, Any]) -> list[str]:
     """
     out = []
     conv = summary["convergence"]
-    if not conv["converged"]:
+    if not conv["converged"] and summary["model_source"] == "none":
+        out.append("no update was accepted: there is no model")
+    elif not conv["converged"]:
         out.append(
-            "the trace did not converge: the model shown is "
+            "the trace did not converge: the model shown is the "
             f"{summary['model_source']}, not a steady state"
         )
     for finding in summary["findings"]:
@@ -130,10 +132,10 @@ def write_track_report(
     files: list[Path] = []
     if model is not None:
         more, files = model_sections(model, out, data=data, data_note=data_note, data_t0=data_t0)
-        more[0].heading = f"Model ({source})"
+        more[0].heading = f"Model: {source}"
         sections += more
     else:
-        result.text = "No update was accepted: there is no model to show."
+        result.text = "The figure of the trace below shows why no estimate was accepted."
     trace_png = out / "trace.png"
     plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     files.append(trace_png)
