@@ -223,3 +223,21 @@ def test_report_renders_in_headless_chromium(track_report, tmp_path):
     pixels = imread(shot)
     assert pixels.shape[:2] == (1400, 1000)
     assert np.std(pixels[..., :3]) > 0.05  # not a blank page: text, tables, figures drawn
+
+
+def test_identify_command_writes_a_report(tmp_path):
+    from click.testing import CliRunner
+
+    from clpc.cli import cli
+
+    path = Path(ds.__file__).parent / "daisy_dryer.csv"
+    args = ["identify", str(path), "-u", "u", "-y", "y", "--dt", "0.08", "--order", "auto"]
+    res = CliRunner().invoke(cli, [*args, "--report", str(tmp_path / "rep")])
+    assert res.exit_code == 0, res.output
+    html_file = tmp_path / "rep" / "report.html"
+    assert f"wrote {html_file}" in res.output
+    page = parse(html_file)
+    check_images(page, html_file.parent)
+    order = [heading_index(page, h) for h in ("Result", "Order selection", "Measured", "Settings")]
+    assert order == sorted(order)
+    assert "(chosen)" in html_file.read_text()
