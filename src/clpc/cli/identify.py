@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import click
 
 from clpc.cli.errors import ClpcCommand
@@ -19,7 +22,7 @@ from clpc.cli.options import (
     save_option,
 )
 from clpc.cli.output import echo_json
-from clpc.report import format_model_summary
+from clpc.report import format_model_summary, write_identify_report
 from clpc.workflows import IdentifyResult, IdentifySettings, identify_file
 
 __all__ = ["identify"]
@@ -81,9 +84,15 @@ def _selection_line(result: IdentifyResult) -> str:
 @sampling_options()
 @json_option()
 @save_option("Save the model (load it again with clpc simulate/compare).")
+@click.option(
+    "--report",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Also write an HTML report with figures to this folder (REPORT/report.html).",
+)
 @record_settings()
 @collect("settings", IdentifySettings)
-def identify(settings: IdentifySettings, as_json: bool) -> None:
+def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> None:
     """Identify a linear model -B(z)/A(z) from a record with batch LPC.
 
     Prints the monic transfer function (powers of z^-1), poles and stability, the degree of
@@ -105,3 +114,27 @@ def identify(settings: IdentifySettings, as_json: bool) -> None:
     click.echo(format_model_summary(result.summary))
     if settings.save:
         click.echo(f"model saved to {settings.save}")
+    if report:
+        click.echo(f"wrote {_write_report(settings, result, report)}")
+
+
+def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: str) -> Any:
+    """The HTML report of a fit (:func:`clpc.report.write_identify_report`)."""
+    record = settings.record
+    shown = {
+        "file": record.file,
+        "order": settings.order,
+        "nk": settings.nk,
+        "method": settings.method,
+        "mimo": settings.mimo,
+        "criterion": settings.criterion if settings.order == "auto" else None,
+    }
+    files = write_identify_report(
+        folder,
+        result.model,
+        record.load(),
+        title=f"LPC identify report: {Path(record.file).name}",
+        settings=shown,
+        selection=result.summary.get("order_selection"),
+    )
+    return files[-1]

@@ -99,7 +99,7 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     """Run the CLPC appraiser over a record (read in chunks) and write a trace and a report.
 
     Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
-    OUT/trace.png, OUT/pz.png, OUT/bode.png and OUT/report.html.
+    OUT/report.html with its figures (trace, fit, data, step, bode, pz .png).
 
     \b
     Examples:

@@ -173,6 +173,16 @@ class IOData:
             f"outputs={list(self.output_names)}, dt={self.dt:g})"
         )
 
+    def plot(self, path: Any = None, *, title: str | None = None, ax: Any = None) -> Any:
+        """Plot every channel against time; returns the figure (needs matplotlib).
+
+        See :func:`clpc.data.plot.plot_iodata` (``path`` also writes a PNG, ``ax`` takes
+        ``n_inputs + n_outputs`` axes).
+        """
+        from clpc.data.plot import plot_iodata
+
+        return plot_iodata(self, path, title=title, ax=ax)
+
     def require_samples(self, needed: int, why: str) -> None:
         """Raise :class:`DataError` unless at least ``needed`` samples are present."""
         if self.n_samples < needed:

@@ -132,7 +132,11 @@ def fig_parameter(path: Path, result: CommandResult, index: int, number: int, dp
     name = _PARAM_NAMES[index]
     _per_cluster(ax, ident, ident.trace.theta[:, index], f"${name}$ (held output)")
     ax.axhline(
-        ident.model.theta[0, index], color="tab:red", lw=1, ls="-.", label="steady-state value"
+        ident.model.theta_matrix[0, index],
+        color="tab:red",
+        lw=1,
+        ls="-.",
+        label="steady-state value",
     )
     ax.set(
         ylabel=f"${name}$ [-] (unit-norm $\\theta$)",

@@ -95,7 +95,7 @@ def parameter_statistics(ident: Identification) -> dict[str, Any]:
     }
     if conv.converged:
         after = np.arange(len(trace)) >= conv.update
-        dev = np.abs(theta[after] - ident.model.theta[0][None, :]).max(axis=0)
+        dev = np.abs(theta[after] - ident.model.theta_matrix[0][None, :]).max(axis=0)
         out.update(
             cluster=int(conv.update) + 1,
             time=float(conv.time),
@@ -115,7 +115,7 @@ def model_summary(model: LinearModel) -> dict[str, Any]:
     with np.errstate(divide="ignore", invalid="ignore"):
         dc = float(model.dc_gain()[0, 0])
     return {
-        "theta": model.theta[0].tolist(),
+        "theta": model.theta_matrix[0].tolist(),
         "den": model.den.tolist(),
         "num": model.num.tolist(),
         "poles": [[float(p.real), float(p.imag)] for p in poles],

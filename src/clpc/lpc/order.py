@@ -143,8 +143,8 @@ def select_order(
         skip = largest - est.structure().max_lag  # drop samples so all use the same rows
         model = est.fit(data[skip:])
         info = model.info
-        n = int(info["n_rows"][0])
-        n_free = (model.theta.shape[1] - 1 + 2) * model.n_outputs
+        n = int(np.atleast_1d(info["n_rows"])[0])
+        n_free = (model.theta_matrix.shape[1] - 1 + 2) * model.n_outputs
         loglik = float(np.sum(info["log_likelihood"]))
         rows.append(
             (

@@ -61,10 +61,10 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             "the model is stable" if stable else "the model is NOT stable",
         )
         return Verdict(0, True, False, stable, model.structure.nb + 1, notes)
-    n_null = int(np.asarray(info["n_null"])[output])
-    n_input = int(np.asarray(info["n_input_relations"])[output])
-    determined = bool(np.asarray(info["determined"])[output])
-    sep = float(np.asarray(info["separation"])[output])
+    n_null = int(np.atleast_1d(info["n_null"])[output])
+    n_input = int(np.atleast_1d(info["n_input_relations"])[output])
+    determined = bool(np.atleast_1d(info["determined"])[output])
+    sep = float(np.atleast_1d(info["separation"])[output])
     try:
         stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
     except ValueError:

@@ -11,9 +11,11 @@ from typing import Any, Literal
 import numpy as np
 
 from clpc.appraiser import CLPC
+from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
-from clpc.data import DataError
+from clpc.core.figure import MAX_POINTS
+from clpc.data import DataError, IOData
 from clpc.io import iter_table_chunks, save_model
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
@@ -137,6 +139,24 @@ class _Clock:
         self.seen += t.size
 
 
+#: the report compares the model with at most this many (decimated) samples at the end
+#: (its figure then draws every sample: see :data:`clpc.core.figure.MAX_POINTS`)
+REPORT_SAMPLES = MAX_POINTS
+
+
+class _Tail:
+    """The last :data:`REPORT_SAMPLES` rows at the appraiser's rate (bounded memory)."""
+
+    def __init__(self, factor: int) -> None:
+        self.decimator = Decimator(factor)
+        self.rows = np.empty((0, 0))
+
+    def feed(self, values: np.ndarray) -> None:
+        kept = self.decimator(values)
+        both = kept if self.rows.size == 0 else np.concatenate([self.rows, kept])
+        self.rows = both[-REPORT_SAMPLES:]
+
+
 @dataclass
 class _Run:
     """The state of one pass over the record."""
@@ -144,6 +164,7 @@ class _Run:
     appraiser: CLPC
     kept: ThinnedTrace
     n_raw: int
+    tail: _Tail
 
 
 def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
@@ -163,8 +184,12 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                     )
             if run is None:
                 data_dt = clock.dt if clock is not None else record.dt
-                run = _Run(settings.appraiser.build(data_dt), ThinnedTrace(), 0)
+                appraiser = settings.appraiser.build(data_dt)
+                rate = data_dt if data_dt is not None else appraiser.data_sample_time
+                factor = decimation_factor(appraiser.sample_time, rate)
+                run = _Run(appraiser, ThinnedTrace(), 0, _Tail(factor))
             run.n_raw += values.shape[0]
+            run.tail.feed(values[:, : n_in + n_out])
             part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
             if len(part):
                 part = dataclasses.replace(
@@ -193,6 +218,30 @@ def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> 
             f"--parameters-size {settings.appraiser.parameters_size} needs at least {needed}; "
             "use a smaller --window or a longer record."
         )
+
+
+def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
+    """The record's last samples as :class:`IOData` for the report, and where they come from."""
+    rows = run.tail.rows
+    n_in = trace.n_inputs
+    if rows.shape[0] <= trace.structure.max_lag + 1:
+        return {}
+    data = IOData(
+        rows[:, :n_in],
+        rows[:, n_in:],
+        dt=trace.sample_time,
+        input_names=trace.input_names,
+        output_names=trace.output_names,
+    )
+    n = run.appraiser.n_samples
+    where = f"all {n}" if rows.shape[0] >= n else f"the last {rows.shape[0]} of the {n}"
+    note = (
+        f"The model against {where} samples of the record (at the appraiser's sample time): "
+        "a free-run simulation that starts from the first measured samples and then uses "
+        "the input alone."
+    )
+    t0 = (n - rows.shape[0]) * trace.sample_time
+    return {"data": data, "data_note": note, "data_t0": t0}
 
 
 def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
@@ -241,7 +290,12 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     }
     summary = trace_summary(trace)
     report = write_track_report(
-        out, trace, title=f"CLPC report: {file}", settings=report_settings, summary=summary
+        out,
+        trace,
+        title=f"CLPC track report: {Path(file).name}",
+        settings=report_settings,
+        summary=summary,
+        **_report_data(run, trace),
     )
     files = [trace_file, *report]
     model, source = steady_state(trace)
