@@ -46,9 +46,8 @@ def render_report(summary: dict[str, Any]) -> str:
         "Identification (a): position command -> measured position (the control system, "
         "Figs. 6-12 and 15-17). Identification (b): torque command -> measured position (the "
         "motor as actuator, Figs. 13-14). The main figures use the paper's ramp with "
-        "saturation; the same pipeline also runs on a richer command (`rich` columns).\n",
-        "## Set-up\n",
-        setup_table(summary),
+        "saturation; the same pipeline also runs on a richer command (`rich` columns). "
+        "Results first; the settings are at the end.\n",
         "## Verdicts at a glance\n",
         verdict_table(summary),
         *section_command(summary),
@@ -62,5 +61,7 @@ def render_report(summary: dict[str, Any]) -> str:
         "Same pipeline, same Table 1 settings; see the `rich` columns above.\n",
         *section_clusters(summary),
         NOTES,
+        "## Settings\n",
+        setup_table(summary),
     ]
     return "\n".join(parts)
