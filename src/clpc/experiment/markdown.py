@@ -129,7 +129,7 @@ def verdict_table(summary: dict[str, Any]) -> str:
         figs = ", ".join(str(f) for f in c["figures"]) or "-"
         cells = [c[n]["verdict"] if n in c else "-" for n in ("ramp", "rich")]
         first: dict[str, Any] = next((c[n] for n in ("ramp", "rich") if n in c), {})
-        crit = first.get("criterion", "-")
+        crit = first.get("criterion", "-").replace("|", "\\|")  # a cell: escape the bars
         rows.append(f"| {c['paper']} | {figs} | {crit} | {cells[0]} | {cells[1]} |")
     return "\n".join(rows) + "\n"
 
