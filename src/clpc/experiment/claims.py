@@ -93,8 +93,9 @@ def _claim_parameters(cs: dict[str, Any], settings: dict[str, Any]) -> dict[str,
     strict = settings["tolerances"][0]
     criterion = (
         f"the convergence rule holds at the strict tolerances ({strict[2]} trusted updates "
-        f"in a row with |d theta| < {strict[0]}, |dD|/D < {strict[1]:.0%}) and after it "
-        f"max ||theta - theta_ss|| < {THETA_BAND}"
+        f"in a row with |d theta| < {strict[0]}, |dD|/D < {strict[1]:.0%}), after it "
+        f"max ||theta - theta_ss|| < {THETA_BAND} and no later step above the rule's "
+        "|d theta| tolerance"
     )
     why = (
         "the library's default rule (clpc.appraiser.convergence, the same the figures "
@@ -115,6 +116,12 @@ def _claim_parameters(cs: dict[str, Any], settings: dict[str, Any]) -> dict[str,
         f"row; after it max ||theta - theta_ss|| = {p['theta_variation']:.3f}; windows the "
         f"solver calls determined: {p['determined_fraction']:.0%}"
     )
+    step = p.get("largest_step")
+    if step is not None:
+        text += (
+            f"; largest step after it {step['size']:.3f} at cluster {step['cluster']} "
+            f"(t = {step['time']:.2f} s)"
+        )
     ok_small = p["theta_variation"] < THETA_BAND
     reason = (
         f"the rule holds only at the relaxed tolerances ({tol[0]}, {tol[1]:.0%})"
@@ -125,7 +132,13 @@ def _claim_parameters(cs: dict[str, Any], settings: dict[str, Any]) -> dict[str,
         reason += ("; " if reason else "") + (
             f"after the marker theta still moves by {p['theta_variation']:.3f}"
         )
-    return _result((p["tolerance_level"] == 0, ok_small), text, criterion, why, reason)
+    steady = step is None or step["size"] < tol[0]
+    if not steady:
+        reason += ("; " if reason else "") + (
+            f"after the marker theta still steps by {step['size']:.3f} (> {tol[0]}) at "
+            f"cluster {step['cluster']}"
+        )
+    return _result((p["tolerance_level"] == 0, ok_small, steady), text, criterion, why, reason)
 
 
 def _claim_stable(cs: dict[str, Any]) -> dict[str, Any]:

@@ -88,6 +88,19 @@ def section_parameters(summary: dict[str, Any]) -> list[str]:
             "are individually weakly identified, while the transfer function is well "
             "determined (see the fits below)."
         )
+    p_r = summary["commands"]["ramp"]["control_system"]["parameters"]
+    step = p_r.get("largest_step")
+    if step is not None:
+        st = summary["settings"]
+        gone = st["ramp"]["start"] + st["window_time"]
+        text += (
+            f" On the ramp the marker is where the convergence rule first holds (cluster "
+            f"{p_r['cluster']}); the rule does not forbid later steps, and the largest one "
+            f"({step['size']:.3f} in ||theta||, cluster {step['cluster']}, t = "
+            f"{step['time']:.2f} s) comes after the ramp's start has left the 2 s window "
+            f"(t = {gone:.2f} s): the windows then hold another part of the motion. The red "
+            "line is the mean of the trusted updates from the marker on, the band their range."
+        )
     return [
         "## Figs. 7-12 - the parameters a01, a11, a21, b01, b11, b21 per cluster\n",
         *[

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
+from clpc.appraiser.convergence import usable
 from clpc.appraiser.trace import Trace
 from clpc.experiment.results import Identification
 from clpc.experiment.settings import A0_MIN, D_QUASI_CONSTANT, LABELS, WINDOW_SIZE
@@ -76,7 +77,11 @@ def d_statistics(trace: Trace) -> dict[str, Any]:
 
 
 def parameter_statistics(ident: Identification) -> dict[str, Any]:
-    """The Figs. 7-12 claim: cluster where theta becomes quasi-constant, variation after it."""
+    """The Figs. 7-12 claim: cluster where theta becomes quasi-constant, variation after it.
+
+    ``largest_step``: the largest ``||theta_j - theta_{j-1}||`` between consecutive trusted
+    updates after the marker, with the cluster and time [s] where it lands.
+    """
     conv, trace = ident.convergence, ident.trace
     theta = trace.theta
     a0 = theta[:, 0]
@@ -96,6 +101,15 @@ def parameter_statistics(ident: Identification) -> dict[str, Any]:
     if conv.converged:
         after = np.arange(len(trace)) >= conv.update
         dev = np.abs(theta[after] - ident.model.theta[0][None, :]).max(axis=0)
+        used = np.flatnonzero(usable(trace) & after)
+        steps = np.linalg.norm(np.diff(theta[used], axis=0), axis=1) if used.size > 1 else []
+        if len(steps):
+            k = int(np.argmax(steps))
+            out["largest_step"] = {
+                "size": float(steps[k]),
+                "cluster": int(used[k + 1]) + 1,
+                "time": float(trace.time[used[k + 1]]),
+            }
         out.update(
             cluster=int(conv.update) + 1,
             time=float(conv.time),
