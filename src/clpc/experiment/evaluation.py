@@ -100,9 +100,14 @@ def evaluate_control_system(
 
 
 def _window_fits(ident: Identification) -> dict[str, Any]:
-    """Torque fit of each trusted window's own model (the best a single cluster gives)."""
+    """Torque fit of each trusted window's own model (the best a single cluster gives).
+
+    Also the best window's ``B(1)`` (``num_sum``) and the last trusted window's
+    (``last_window_num_sum``).
+    """
     trace, u, y = ident.trace, ident.u, ident.y
-    best: dict[str, Any] = {"cluster": None, "time": None, "fit": None}
+    best: dict[str, Any] = {"cluster": None, "time": None, "fit": None, "num_sum": None}
+    last_b1 = None
     for j in np.flatnonzero(trace.trusted & trace.has_model & (trace.theta[:, 0] >= A0_MIN)):
         model = LinearModel(
             theta=trace.theta[j][None, :],
@@ -114,8 +119,11 @@ def _window_fits(ident: Identification) -> dict[str, Any]:
         )
         with np.errstate(over="ignore", invalid="ignore"):
             f = fit(u, stable_inverse(model, y))
+        last_b1 = float(model.num.sum())
         if f is not None and (best["fit"] is None or f > best["fit"]):
             best = {"cluster": int(j) + 1, "time": float(trace.time[j]), "fit": f}
+            best["num_sum"] = last_b1
+    best["last_window_num_sum"] = last_b1
     return best
 
 
