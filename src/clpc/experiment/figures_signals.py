@@ -37,6 +37,7 @@ def _torque_panel(
     ax: Axes, u: np.ndarray, u_hat: np.ndarray, act: dict[str, Any], what: str
 ) -> None:
     t = times(u.size)
+    ax.axvspan(0.0, RAMP.start, color="0.75", alpha=0.35, lw=0, label="at rest before the ramp")
     ax.plot(t, u, lw=1.2, label="experimental torque command")
     ax.plot(t, u_hat, lw=1.0, ls="--", label="estimated torque command")
     ax.set_title(f"{what}: torque fit {fmt(act['torque_fit'], '.1f')} %", fontsize=9)
@@ -68,6 +69,7 @@ def fig_torque(path: Path, result: CommandResult, smooth: TorqueCheck, dpi: int)
 def _error_panel(ax: Axes, err: np.ndarray, act: dict[str, Any], what: str) -> None:
     t = times(err.size)
     noise = 1e3 * act["torque_noise_level"]
+    ax.axvspan(0.0, RAMP.start, color="0.75", alpha=0.35, lw=0, label="at rest before the ramp")
     ax.axhspan(-noise, noise, color="tab:green", alpha=0.2, lw=0, label="noise level (+-)")
     ax.plot(t, 1e3 * err, lw=1.0, color="tab:red", label="experimental - estimated")
     ax.axhline(0.0, color="0.4", lw=0.8)
