@@ -23,8 +23,10 @@ is evaluated on the same decimated signals (:func:`clpc.appraiser.decimation.dec
 the appraiser's own filter).
 
 Data flow (no module imports one above it): ``settings`` -> ``results`` -> ``analysis``,
-``statistics``, ``identification`` -> ``evaluation`` -> ``claims`` -> ``markdown`` ->
-``sections`` -> ``report``; ``figures``; ``run`` (this module) calls them all.
+``statistics``, ``identification`` -> ``evaluation`` -> ``claim_checks`` -> ``claims`` ->
+``markdown`` -> ``sections`` -> ``report``; ``marks`` -> ``figure_base``,
+``figures_signals`` -> ``figures``; ``run`` (this module) calls them all. A further section
+of the demo is one more ``analyse_*`` call here, its numbers one more key of the summary.
 """
 
 from __future__ import annotations
