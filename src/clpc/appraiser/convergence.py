@@ -13,7 +13,7 @@ import numpy as np
 
 from clpc.model import LinearModel
 
-__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model"]
+__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model", "usable"]
 
 
 @dataclass(frozen=True)
@@ -23,7 +23,7 @@ class Convergence:
     Attributes
     ----------
     converged : bool
-        Whether ``consecutive`` accepted updates in a row changed less than the tolerances.
+        Whether ``consecutive`` :func:`usable` updates in a row changed less than the tolerances.
     update : int
         Row of the trace where the quasi-constant phase starts (-1 if never).
     index : int
@@ -35,7 +35,7 @@ class Convergence:
         ``|D_j - D_{j-1}| / D_j``.
     consecutive : int
     theta_variation : float
-        After convergence: largest ``||theta_j - theta_ss||`` over accepted updates.
+        After convergence: largest ``||theta_j - theta_ss||`` over :func:`usable` updates.
     D_variation : float
         After convergence: largest ``|D_j - mean D| / mean D``.
     trusted_fraction : float
@@ -63,6 +63,20 @@ class Convergence:
 MIN_TRUSTED_FRACTION = 0.5
 
 
+def usable(trace: Any) -> np.ndarray:
+    """Updates that count for convergence and the steady state, shape ``(len(trace),)``.
+
+    Accepted, holding a model and from a trusted window, for every equation (traces
+    without a ``trusted`` column: accepted and holding a model).
+    """
+    arrays = trace.arrays
+    ok = arrays["accepted"].all(axis=1) & arrays["has_model"].all(axis=1)
+    trusted = arrays.get("trusted")
+    if trusted is not None:
+        ok = ok & trusted.all(axis=1)
+    return np.asarray(ok, dtype=bool)
+
+
 def convergence(
     trace: Any, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
 ) -> Convergence:
@@ -71,9 +85,10 @@ def convergence(
     An update is quasi-constant when every equation's accepted ``theta`` moved by less
     than ``theta_tol`` (Euclidean, unit vectors) and ``D`` by less than ``D_tol``
     (relative) since the previous update; convergence needs ``consecutive`` such
-    updates in a row.
+    updates in a row. Only updates from trusted windows count (:func:`usable`): with
+    ``guard=False`` the appraiser also accepts untrusted ones, which say nothing reliable.
     """
-    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    acc = usable(trace)
     theta = trace.arrays["theta"]
     d: np.ndarray = trace.arrays["D"]
     n = len(trace)
@@ -98,7 +113,7 @@ def convergence(
         return Convergence(False, -1, -1, *none, frac, why)
     if hits.size == 0:
         why = (
-            f"not converged: no {consecutive} accepted updates in a row moved theta by "
+            f"not converged: no {consecutive} trusted, accepted updates in a row moved theta by "
             f"less than {theta_tol:g} and D by less than {D_tol:.0%}"
         )
         return Convergence(False, -1, -1, *none, frac, why)
@@ -109,9 +124,9 @@ def convergence(
     d_mean = d[after].mean(axis=0)
     d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
     why = (
-        f"converged at update {start + 1}: {consecutive} accepted updates in a row moved "
-        f"theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; {frac:.0%} of "
-        "the windows are trusted"
+        f"converged at update {start + 1}: {consecutive} trusted, accepted updates in a row "
+        f"moved theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; "
+        f"{frac:.0%} of the windows are trusted"
     )
     return Convergence(
         True,
@@ -131,9 +146,17 @@ def convergence(
 def steady_state_model(
     trace: Any, conv: Convergence | None = None, *, allow_unconverged: bool = False
 ) -> LinearModel:
-    """The mean accepted ``theta`` after convergence (:meth:`clpc.Trace.steady_state_model`)."""
+    """The mean ``theta`` of the :func:`usable` updates after convergence.
+
+    See :meth:`clpc.Trace.steady_state_model`; unconverged with ``allow_unconverged``: the
+    last usable update (the last accepted one when no window is trusted).
+    """
     conv = conv or convergence(trace)
-    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    acc = usable(trace)
+    if not conv.converged and not acc.any():  # no trusted update: the last accepted one
+        acc = np.asarray(
+            trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1)
+        )
     if conv.converged:
         sel = acc & (np.arange(len(trace)) >= conv.update)
     elif allow_unconverged and acc.any():
