@@ -6,11 +6,19 @@ functions (``trace`` is a :class:`clpc.Trace`).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.spread import (
+    GAIN_SPREAD_LIMIT,
+    TREND_LIMIT,
+    gain_spread,
+    level_trend,
+    window_dc_gains,
+)
 from clpc.model import LinearModel
 
 __all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model"]
@@ -147,6 +155,7 @@ def steady_state_model(
         )
     theta = _mean_theta(trace.arrays["theta"][sel])
     c = trace.arrays["c"][sel].mean(axis=0)
+    spread = _warn_if_windows_disagree(trace, sel)
     return LinearModel(
         theta=theta,
         structure=trace.structure,
@@ -162,8 +171,37 @@ def steady_state_model(
             "scaling": trace.meta.get("scaling"),
             "guard": trace.meta.get("guard"),
             "updates_used": int(sel.sum()),
+            "gain_spread": spread,
         },
     )
+
+
+def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
+    """Warn loudly when the averaged windows' DC gains follow their output level (SISO).
+
+    Needs the windows' levels (``trace.meta["window_level"]``, stored by
+    :meth:`clpc.CLPC.run`); returns the gain spread, or None when it cannot be judged.
+    """
+    levels = trace.meta.get("window_level")
+    if trace.n_inputs != 1 or trace.n_equations != 1 or levels is None:
+        return None
+    gains = window_dc_gains(trace.arrays["theta"][sel][:, 0, :], trace.structure.na)
+    spread = gain_spread(gains)
+    rho = level_trend(np.asarray(levels)[sel, 0], gains)
+    if spread > GAIN_SPREAD_LIMIT and abs(rho) >= TREND_LIMIT:
+        finite = gains[np.isfinite(gains)]
+        warnings.warn(
+            "THE STEADY-STATE MODEL MIXES OPERATING POINTS: the averaged windows' DC gains run "
+            f"from {np.percentile(finite, 10):.3g} to {np.percentile(finite, 90):.3g} (10th-90th "
+            f"percentile; relative spread {spread:.2f} > {GAIN_SPREAD_LIMIT}) and follow the "
+            f"output level (rank correlation {rho:+.2f}, limit +/-{TREND_LIMIT}). One average "
+            "of them can be worse than one global fit; see "
+            "clpc.operating_point_diagnostics(trace, u, y) and use "
+            "clpc.MultiModel.from_trace(trace, u, y).",
+            UserWarning,
+            stacklevel=3,
+        )
+    return spread
 
 
 def _mean_theta(theta: np.ndarray) -> np.ndarray:
