@@ -184,7 +184,7 @@ def test_operating_point_diagnostics_and_steady_state_warning(nonlinear):
     rep = operating_point_diagnostics(trace, ident.command, ident.position)
     assert rep.multimodel_recommended and rep.windows_local
     assert "multi-model is recommended" in rep.verdict
-    with pytest.warns(UserWarning, match="MIXES OPERATING POINTS"):
+    with pytest.warns(UserWarning, match="MODELS CHANGE WITH THE OUTPUT LEVEL"):
         trace.steady_state_model()
     mm = clpc.MultiModel.from_trace(trace, ident.command, ident.position)
     assert mm.diagnostics["windows"] == "the CLPC trace's trusted windows"

@@ -191,13 +191,14 @@ def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
     if spread > GAIN_SPREAD_LIMIT and abs(rho) >= TREND_LIMIT:
         finite = gains[np.isfinite(gains)]
         warnings.warn(
-            "THE STEADY-STATE MODEL MIXES OPERATING POINTS: the averaged windows' DC gains run "
-            f"from {np.percentile(finite, 10):.3g} to {np.percentile(finite, 90):.3g} (10th-90th "
-            f"percentile; relative spread {spread:.2f} > {GAIN_SPREAD_LIMIT}) and follow the "
-            f"output level (rank correlation {rho:+.2f}, limit +/-{TREND_LIMIT}). One average "
-            "of them can be worse than one global fit; see "
-            "clpc.operating_point_diagnostics(trace, u, y) and use "
-            "clpc.MultiModel.from_trace(trace, u, y).",
+            "THE STEADY-STATE MODEL AVERAGES WINDOWS WHOSE MODELS CHANGE WITH THE OUTPUT "
+            f"LEVEL: their DC gains run from {np.percentile(finite, 10):.3g} to "
+            f"{np.percentile(finite, 90):.3g} (10th-90th percentile; relative spread "
+            f"{spread:.2f} > {GAIN_SPREAD_LIMIT}) and follow the level (rank correlation "
+            f"{rho:+.2f}, limit +/-{TREND_LIMIT}). A nonlinear plant does this (the average "
+            "mixes operating points and can be worse than one global fit: use "
+            "clpc.MultiModel.from_trace(trace, u, y)); so do windows too poorly excited to "
+            "fix their gain. clpc.operating_point_diagnostics(trace, u, y) tells which.",
             UserWarning,
             stacklevel=3,
         )

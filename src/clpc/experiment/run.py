@@ -41,6 +41,7 @@ from clpc.core.jsonable import jsonable
 from clpc.experiment.claims import claims
 from clpc.experiment.evaluation import aliasing_check, analyse_command, extended_ramp
 from clpc.experiment.figures import write_figures
+from clpc.experiment.nonlinear import nonlinear_claim, run_nonlinear
 from clpc.experiment.report import render_report
 from clpc.experiment.settings import (
     LOG_SAMPLE_TIME,
@@ -140,6 +141,8 @@ def run_experiment(
         "aliasing_check": aliasing_check(rich_fn, seeds[4], method, params),
     }
     summary["claims"] = claims(summary)
+    summary["nonlinear_servo"] = run_nonlinear(out, seed=seed, quick=quick)  # issue 18
+    summary["claims"].append(nonlinear_claim(summary["nonlinear_servo"]))
     summary["figures"] = write_figures(out, ramp, rich, quick=quick)
     summary["runtime_s"] = time.perf_counter() - t_start
     summary = jsonable(summary)
