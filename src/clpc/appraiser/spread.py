@@ -24,13 +24,15 @@ __all__ = [
 ]
 
 #: Relative spread of the windows' DC gains, ``(P90 - P10) / |median|``, above which the
-#: windows disagree (the crank servo of :mod:`clpc.plants.crank_servo`: 0.92; its
-#: negative control with the velocity integrator: 0.46, whose windows are too short to
-#: settle the integrator; ``benchmarks/multimodel.py`` prints both).
-GAIN_SPREAD_LIMIT = 0.25
+#: windows disagree. Measured: the crank servo of :mod:`clpc.plants.crank_servo` 0.84-0.93;
+#: its negative control with the velocity integrator 0.42-0.46 (its windows are too short to
+#: settle the integrator); linear records of the test suite (a tracked chirp, the quick
+#: demo's actuator) up to 0.32, which the first limit tried (0.25) flagged.
+GAIN_SPREAD_LIMIT = 0.35
 #: |Spearman rank correlation| between the windows' DC gains and their output levels above
-#: which the disagreement follows the operating point (crank servo: 0.94)
-TREND_LIMIT = 0.5
+#: which the disagreement follows the operating point (crank servo 0.93-0.94, its control
+#: 0.72-0.82; those linear records 0.52-0.53)
+TREND_LIMIT = 0.6
 
 
 def attach_levels(trace: Any, y: np.ndarray, factor: int) -> None:
