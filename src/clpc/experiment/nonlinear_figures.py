@@ -63,7 +63,8 @@ def plot_multimodel(
     if reference is not None:
         rpsi, rgain, rpoles = (np.asarray(r) for r in reference)
         ax1.plot(rpsi, rgain, "k--", lw=1, label="plant, closed form")
-        ax2.plot(rpsi, np.abs(rpoles[:, 0]), "k--", lw=1, label="plant, closed form")
+        if np.any(np.isfinite(rpoles)):
+            ax2.plot(rpsi, np.abs(rpoles[:, 0]), "k--", lw=1, label="plant, closed form")
     ax1.set_ylabel("local DC gain")
     ax1.legend(fontsize=7)
     ax2.set_ylabel("pole frequency [Hz]")

@@ -265,7 +265,8 @@ def crank_operating_point(command: Any, params: CrankParameters | None = None) -
         Small-signal gain ``dy/dr`` there (1 with the integrator).
     poles_hz : ndarray of complex, shape (..., 2)
         Roots of ``J(y) s^2 + (Kv + b) s + Kv Kp + m g r cos y`` divided by ``2 pi`` [Hz]
-        (P-P loop; filter, friction and limits neglected).
+        (P-P loop; filter, friction and limits neglected). NaN with the velocity
+        integrator, whose extra pole and zero this formula does not model.
     """
     prm = CrankParameters() if params is None else params
     r = np.asarray(command, dtype=np.float64)
@@ -283,6 +284,8 @@ def crank_operating_point(command: Any, params: CrankParameters | None = None) -
     damp = prm.velocity_gain + prm.viscous_friction
     disc = np.sqrt((damp**2 - 4.0 * j * stiff).astype(complex))
     poles = np.stack([(-damp + disc) / (2 * j), (-damp - disc) / (2 * j)], axis=-1)
+    if prm.velocity_integrator != 0:  # the P-P formula does not hold: not modelled
+        poles = np.full_like(poles, complex(np.nan, np.nan))
     return y, gain, poles / (2.0 * math.pi)
 
 
