@@ -185,6 +185,8 @@ def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
     levels = trace.meta.get("window_level")
     if trace.n_inputs != 1 or trace.n_equations != 1 or levels is None:
         return None
+    if np.shape(levels)[0] != len(trace):  # rows added or dropped since run(): not judged
+        return None
     gains = window_dc_gains(trace.arrays["theta"][sel][:, 0, :], trace.structure.na)
     spread = gain_spread(gains)
     rho = level_trend(np.asarray(levels)[sel, 0], gains)

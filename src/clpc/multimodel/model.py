@@ -26,6 +26,7 @@ from clpc.model import LinearModel
 from clpc.model.errors import as_2d
 from clpc.model.structure import Structure
 from clpc.multimodel.fitting import Fitted, Windows, blend_run, fit_all, monic_arrays, own_windows
+from clpc.multimodel.prediction import predict_kstep
 from clpc.multimodel.schedule import Schedule, parse_schedule
 from clpc.multimodel.validity import validity
 
@@ -266,28 +267,7 @@ class MultiModel:
             raise ValueError(
                 f"u and y must have the same length; got {u2.shape[0]}, {y1.shape[0]}."
             )
-        den, num, icpt = monic_arrays(f.local_models)
-        s = self.structure
-        start = max(s.max_lag, sched.lag)
-        n = y1.shape[0]
-        forced = np.tile(icpt, (n - start, 1))
-        for c in range(self.n_inputs):
-            for lag in range(num.shape[2]):
-                forced += u2[start - lag : n - lag, c, None] * num[None, :, c, lag]
-        preds = [y1]
-        for step in range(1, k + 1):
-            local = forced.copy()
-            for lag in range(1, s.na + 1):
-                src = preds[max(step - lag, 0)]
-                local -= src[start - lag : n - lag, None] * den[None, :, lag]
-            ysrc = preds[max(step - 1, 0)] if sched.kind != 1 else y1
-            if sched.kind == 0:
-                ysrc = preds[max(step - sched.lag, 0)]
-            psi = sched.values(u2, ysrc)[start:]
-            cur = y1.copy()
-            cur[start:] = (validity(psi, f.centres, f.widths) * local).sum(axis=1)
-            preds.append(cur)
-        return preds[k]
+        return predict_kstep(monic_arrays(f.local_models), f, sched, self.structure, u2, y1, k)
 
     def linearize(self, operating_point: float) -> LinearModel:
         """The frozen-validity local model at a scheduling value (a :class:`LinearModel`).
