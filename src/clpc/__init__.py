@@ -9,6 +9,7 @@ machine and reports time-varying parameters and the degree of linearity of each 
 from clpc import _moved
 from clpc._version import __version__
 from clpc.analysis.metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
+from clpc.analysis.operating_point import operating_point_diagnostics
 from clpc.appraiser import CLPC, Convergence, Trace
 from clpc.data import DataError, IOData, as_iodata
 from clpc.io import load_iodata, load_model, read_table, save_model, write_table
@@ -26,6 +27,7 @@ from clpc.lpc import (
     simulate_arx,
 )
 from clpc.model import LinearModel, ModelError, Structure, Verdict, describe_trace, fit_verdict
+from clpc.multimodel import MultiModel
 
 _moved.install()
 
@@ -39,6 +41,7 @@ __all__ = [
     "IOData",
     "LinearModel",
     "ModelError",
+    "MultiModel",
     "NoiseEstimate",
     "OrderSelection",
     "RobustRule",
@@ -55,6 +58,7 @@ __all__ = [
     "load_iodata",
     "load_model",
     "lpc_solve",
+    "operating_point_diagnostics",
     "read_table",
     "rmse",
     "save_model",

@@ -6,11 +6,19 @@ functions (``trace`` is a :class:`clpc.Trace`).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.spread import (
+    GAIN_SPREAD_LIMIT,
+    TREND_LIMIT,
+    gain_spread,
+    level_trend,
+    window_dc_gains,
+)
 from clpc.model import LinearModel
 
 __all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model", "usable"]
@@ -170,6 +178,7 @@ def steady_state_model(
         )
     theta = _mean_theta(trace.arrays["theta"][sel])
     c = trace.arrays["c"][sel].mean(axis=0)
+    spread = _warn_if_windows_disagree(trace, sel)
     return LinearModel(
         theta=theta,
         structure=trace.structure,
@@ -185,8 +194,40 @@ def steady_state_model(
             "scaling": trace.meta.get("scaling"),
             "guard": trace.meta.get("guard"),
             "updates_used": int(sel.sum()),
+            "gain_spread": spread,
         },
     )
+
+
+def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
+    """Warn loudly when the averaged windows' DC gains follow their output level (SISO).
+
+    Needs the windows' levels (``trace.meta["window_level"]``, stored by
+    :meth:`clpc.CLPC.run`); returns the gain spread, or None when it cannot be judged.
+    """
+    levels = trace.meta.get("window_level")
+    if trace.n_inputs != 1 or trace.n_equations != 1 or levels is None:
+        return None
+    if np.shape(levels)[0] != len(trace):  # rows added or dropped since run(): not judged
+        return None
+    gains = window_dc_gains(trace.arrays["theta"][sel][:, 0, :], trace.structure.na)
+    spread = gain_spread(gains)
+    rho = level_trend(np.asarray(levels)[sel, 0], gains)
+    if spread > GAIN_SPREAD_LIMIT and abs(rho) >= TREND_LIMIT:
+        finite = gains[np.isfinite(gains)]
+        warnings.warn(
+            "THE STEADY-STATE MODEL AVERAGES WINDOWS WHOSE MODELS CHANGE WITH THE OUTPUT "
+            f"LEVEL: their DC gains run from {np.percentile(finite, 10):.3g} to "
+            f"{np.percentile(finite, 90):.3g} (10th-90th percentile; relative spread "
+            f"{spread:.2f} > {GAIN_SPREAD_LIMIT}) and follow the level (rank correlation "
+            f"{rho:+.2f}, limit +/-{TREND_LIMIT}). A nonlinear plant does this (the average "
+            "mixes operating points and can be worse than one global fit: use "
+            "clpc.MultiModel.from_trace(trace, u, y)); so do windows too poorly excited to "
+            "fix their gain. clpc.operating_point_diagnostics(trace, u, y) tells which.",
+            UserWarning,
+            stacklevel=3,
+        )
+    return spread
 
 
 def _mean_theta(theta: np.ndarray) -> np.ndarray:

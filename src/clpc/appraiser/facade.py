@@ -40,6 +40,7 @@ from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.engine import resolve_engine
 from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
+from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup, TraceLabels
 from clpc.core.checks import check_bool, check_choice, check_int, check_positive
@@ -341,7 +342,10 @@ class CLPC:
         self._decimator = Decimator(self._factor_for(data_dt))
         if self.sample_time is None and data_dt is not None:
             self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        return self.push(u_arr, y_arr)
+        trace = self.push(u_arr, y_arr)
+        factor = self._decimator.factor if self._decimator is not None else 1
+        attach_levels(trace, y_arr, factor)  # the windows' levels, for steady_state_model
+        return trace
 
     def _executor(self) -> ThreadPoolExecutor:
         """A thread pool kept for the appraiser's lifetime (created on first use)."""

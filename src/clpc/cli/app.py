@@ -11,6 +11,7 @@ from clpc.cli.errors import ClpcGroup
 from clpc.cli.identify import identify
 from clpc.cli.info import datasets, demo
 from clpc.cli.models import compare, simulate
+from clpc.cli.multimodel import multimodel
 from clpc.cli.stream import stream
 from clpc.cli.track import track
 
@@ -31,7 +32,7 @@ def cli() -> None:
     """  # noqa: D301
 
 
-for _command in (identify, track, stream, simulate, compare, datasets, demo):
+for _command in (identify, track, stream, simulate, compare, datasets, demo, multimodel):
     cli.add_command(_command)
 
 

@@ -11,6 +11,7 @@ from typing import Any
 
 from clpc.experiment.claims import claims
 from clpc.experiment.markdown import img, setup_table, verdict_table
+from clpc.experiment.nonlinear import section_nonlinear
 from clpc.experiment.sections import (
     section_clusters,
     section_command,
@@ -61,6 +62,7 @@ def render_report(summary: dict[str, Any]) -> str:
         img(summary, "rich", "Rich command: command, D, parameters and torque estimate"),
         "Same pipeline, same Table 1 settings; see the `rich` columns above.\n",
         *section_clusters(summary),
+        *section_nonlinear(summary),
         NOTES,
         "## Settings\n",
         setup_table(summary),

@@ -48,6 +48,7 @@ from clpc.experiment.evaluation import (
     torque_without_friction,
 )
 from clpc.experiment.figures import write_figures
+from clpc.experiment.nonlinear import nonlinear_claim, run_nonlinear
 from clpc.experiment.report import render_report
 from clpc.experiment.settings import (
     LOG_SAMPLE_TIME,
@@ -150,6 +151,8 @@ def run_experiment(
         "aliasing_check": aliasing_check(rich_fn, seeds[4], method, params),
     }
     summary["claims"] = claims(summary)
+    summary["nonlinear_servo"] = run_nonlinear(out, seed=seed, quick=quick)  # issue 18
+    summary["claims"].append(nonlinear_claim(summary["nonlinear_servo"]))
     summary["figures"] = write_figures(out, ramp, rich, smooth, quick=quick)
     summary["runtime_s"] = time.perf_counter() - t_start
     summary = jsonable(summary)
