@@ -35,3 +35,18 @@ def test_nonlinear_part_judges_the_claim_on_the_plant_and_its_control(tmp_path):
     text = "\n".join(section_nonlinear(summary))
     assert "multi-model is recommended" in text and "figN_nonlinear_multimodel.png" in text
     assert section_nonlinear({"claims": []}) == []
+
+
+def test_verdict_table_shows_the_crank_servo_verdicts() -> None:
+    from clpc.experiment.markdown import verdict_table
+
+    claim = {
+        "paper": "clusters identify better than one global fit (crank servo)",
+        "figures": [],
+        "nonlinear": {"verdict": "reproduced", "criterion": "margin 2 points"},
+        "control": {"verdict": "not reproduced", "criterion": "margin 2 points"},
+    }
+    row = verdict_table({"claims": [claim]}).splitlines()[-1]
+    assert "nonlinear: reproduced" in row
+    assert "control: not reproduced" in row
+    assert "margin 2 points" in row

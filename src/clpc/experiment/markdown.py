@@ -127,11 +127,26 @@ def verdict_table(summary: dict[str, Any]) -> str:
     ]
     for c in summary["claims"]:
         figs = ", ".join(str(f) for f in c["figures"]) or "-"
-        cells = [c[n]["verdict"] if n in c else "-" for n in ("ramp", "rich")]
-        first: dict[str, Any] = next((c[n] for n in ("ramp", "rich") if n in c), {})
+        columns = ("ramp", "rich") if "ramp" in c or "rich" in c else _other_columns(c)
+        cells = [_cell(c, n, columns) for n in columns]
+        first: dict[str, Any] = next((c[n] for n in columns if n in c), {})
         crit = first.get("criterion", "-").replace("|", "\\|")  # a cell: escape the bars
+        cells += ["-"] * (2 - len(cells))
         rows.append(f"| {c['paper']} | {figs} | {crit} | {cells[0]} | {cells[1]} |")
     return "\n".join(rows) + "\n"
+
+
+def _other_columns(claim: dict[str, Any]) -> tuple[str, ...]:
+    """The scenario keys of a claim judged on other records than the ramp and rich command."""
+    return tuple(k for k, v in claim.items() if isinstance(v, dict) and "verdict" in v)[:2]
+
+
+def _cell(claim: dict[str, Any], name: str, columns: tuple[str, ...]) -> str:
+    """A verdict cell, prefixed with its scenario when it is not the column's own command."""
+    if name not in claim:
+        return "-"
+    verdict = claim[name]["verdict"]
+    return verdict if columns == ("ramp", "rich") else f"{name}: {verdict}"
 
 
 def yes(flag: bool, yes: str, no: str) -> str:
