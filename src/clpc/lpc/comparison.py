@@ -20,7 +20,6 @@ from clpc.model import LinearModel, ModelError
 __all__ = [
     "MAKERS",
     "PARSIMONY",
-    "PREFER_OE",
     "best_row",
     "candidate",
     "choose",
@@ -32,9 +31,6 @@ __all__ = [
 
 #: Points of free-run fit a lower order or a smaller delay may give away.
 PARSIMONY = 1.0
-#: OE (the estimator that minimises the free-run error) is kept when no other candidate
-#: beats its held-out free run by more than this many points.
-PREFER_OE = 1.0
 MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
 _USABLE = ("stable", "integrating")
 
@@ -111,9 +107,7 @@ def best_row(rows: list[dict[str, Any]], idx: list[int]) -> tuple[int, bool]:
     """The chosen row among ``idx`` (see the module) and whether it is strictly stable."""
     level = min(tier(rows[i]) for i in idx)
     pool = [i for i in idx if tier(rows[i]) == level]
-    top = max(pool, key=lambda i: rows[i]["free_run"])
-    near = [i for i in pool if rows[i]["free_run"] >= rows[top]["free_run"] - PREFER_OE]
-    top = next((i for i in near if rows[i]["estimator"] == "oe"), top)
+    top = max(pool, key=lambda i: rows[i]["free_run"])  # the first of equals
     return top, level == 0
 
 

@@ -5,15 +5,18 @@ fitted on the first ``1 - f`` of the record and scored on the last ``f``, then f
 last ``1 - f`` and scored on the first ``f`` (``f = validation_fraction``). Each fold gives,
 per output, the **free-run** fit % (the simulation from the input alone, started from the
 measured samples before the scored ones) and the **k-step** prediction fit % (``k``: one
-dominant time constant of the least-squares model, :func:`clpc.lpc.heldout.horizon`); the
-table holds their means over the two folds (two folds, because one held-out stretch of a
-real record often favours an estimator by chance).
+dominant time constant of the least-squares model of the first fold,
+:func:`clpc.lpc.heldout.horizon`); the table holds their means over the two folds (two, so
+that no single stretch of the record decides alone).
 
-* **Choice**, per output: among the stable (or integrating) candidates the highest free-run
-  fit wins: the model is meant to simulate the process, and the free run is the stricter
-  test (a prediction re-reads the measured output every ``k`` samples). A candidate that is
-  unstable in either fold is never chosen while a stable one exists. Outputs are separate
-  equations, so a multi-output model may take each output from another estimator.
+* **Choice**, per output: the highest free-run fit among the candidates whose poles are all
+  strictly inside the unit circle in both folds (if there are none: among those within
+  :data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL` of it, then among the rest). The model is meant
+  to simulate the process, and the free run is the stricter test (a prediction re-reads the
+  measured output every ``k`` samples). So an unstable model is never chosen while a stable
+  candidate exists; OE is stable by construction, so one always does when OE can be fitted.
+  Outputs are separate equations, so a multi-output model may take each output from
+  another estimator (``info["estimators"]``).
 * **Order** (``order="auto"``): the lowest order whose mean over the outputs of the chosen
   free-run fits is within :data:`PARSIMONY` points of the best order's.
 * **Delay** (``nk="auto"``): every candidate at each ``nk`` in ``0..max_delay``; the ``nk``
@@ -40,7 +43,6 @@ from clpc.lpc import heldout
 from clpc.lpc.arx import ARX
 from clpc.lpc.comparison import (
     MAKERS,
-    PREFER_OE,
     choose,
     choose_delay,
     grid,
@@ -233,10 +235,7 @@ def _why(
         if estimator != "auto":
             how = "as asked"
         elif level == 0:
-            how = (
-                "the best held-out free run among the stable candidates (OE unless another "
-                f"is better by more than {PREFER_OE:g} point(s))"
-            )
+            how = "the best held-out free run among the stable candidates"
         elif level == 1:
             how = "no candidate is strictly stable; the best of those on the unit circle"
         else:
