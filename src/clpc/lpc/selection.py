@@ -189,10 +189,10 @@ def identify(
     chosen = tuple(rows[i]["estimator"] for i in picks)
     model = _final(data, chosen, pick_order, chosen_nk, mimo)
     try:
-        eiv: EivCheck | None = check_eiv(
-            data,
-            OE(order=pick_order, nk=chosen_nk, mimo=mimo).fit(data),  # type: ignore[arg-type]
-        )
+        oe_model = model  # the chosen OE fit, or a new one
+        if set(chosen) != {"oe"}:
+            oe_model = OE(order=pick_order, nk=chosen_nk, mimo=mimo).fit(data)  # type: ignore[arg-type]
+        eiv: EivCheck | None = check_eiv(data, oe_model)
     except (ModelError, DataError, np.linalg.LinAlgError):
         eiv = None
     parts = [_why(rows, picks, estimator, k, names)]
