@@ -61,3 +61,14 @@ def test_bad_combinations_are_refused():
     args = ("--estimator", "arx", "--order", "auto", "--criterion", "bic")
     res = run("identify", DRYER, "-u", "u", "-y", "y", *args)
     assert res.exit_code == 1 and "held-out data only" in res.output
+
+
+def test_order_auto_with_an_estimator_lists_every_order():
+    args = ("--estimator", "arx", "--order", "auto", "--max-order", "3", "--json")
+    res = run("identify", DRYER, "-u", "u", "-y", "y", *args)
+    assert res.exit_code == 0, res.output
+    comp = json.loads(res.output)["comparison"]
+    assert sorted({r["order"] for r in comp["table"]}) == [1, 2, 3]
+    assert comp["estimators"] == ["arx"]
+    lib = clpc.identify(ds.load("dryer"), estimator="arx", order="auto", max_order=3)
+    assert comp["order"] == lib.order and "as asked" in comp["reason"]
