@@ -8,7 +8,8 @@ import pytest
 from scipy import optimize, signal
 
 import clpc
-from clpc.lpc.oe import OE, _Problem, poly_from_reflection, reflection_from_poly
+from clpc.lpc.oe import OE, _Problem
+from clpc.lpc.reflection import poly_from_reflection, reflection_from_poly
 from clpc.lpc.regressors import lagged
 
 A = np.array([1.0, -1.5, 0.7])  # poles 0.75 +- 0.37j
