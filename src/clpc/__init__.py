@@ -26,6 +26,7 @@ from clpc.lpc import (
     simulate_arx,
 )
 from clpc.model import LinearModel, ModelError, Structure, Verdict, describe_trace, fit_verdict
+from clpc.model.residuals import ResidualAnalysis, residual_analysis
 
 _moved.install()
 
@@ -41,6 +42,7 @@ __all__ = [
     "ModelError",
     "NoiseEstimate",
     "OrderSelection",
+    "ResidualAnalysis",
     "RobustRule",
     "Structure",
     "Trace",
@@ -56,6 +58,7 @@ __all__ = [
     "load_model",
     "lpc_solve",
     "read_table",
+    "residual_analysis",
     "rmse",
     "save_model",
     "select_delay",

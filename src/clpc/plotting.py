@@ -24,7 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from clpc.appraiser.trace import Trace
     from clpc.model import LinearModel
 
-__all__ = ["plot_bode", "plot_compare", "plot_pz", "plot_trace"]
+__all__ = ["plot_bode", "plot_compare", "plot_pz", "plot_residuals", "plot_trace"]
 
 _INSTALL_HINT = "plotting needs matplotlib: pip install 'clpc[plot]'"
 
@@ -281,3 +281,65 @@ def plot_bode(
     ax_m.legend(loc="best", fontsize="small")
     ax_m.set_title(title or "Bode plot")
     return _save(fig, path)
+
+
+def plot_residuals(analysis: Any, ax: Any = None) -> Figure:
+    """Residual autocorrelation and input-residual cross-correlation with their bands.
+
+    One row per output: the autocorrelation ``rho_e(k)``, ``k = 0..M``, then the
+    cross-correlation with each input, ``tau = -M..M``; the shaded bands are the per-lag
+    limits of :func:`clpc.residual_analysis` and each title gives the test's outcome.
+
+    Parameters
+    ----------
+    analysis : ResidualAnalysis
+        From :func:`clpc.residual_analysis`.
+    ax : sequence of matplotlib Axes, optional
+        ``n_outputs * (1 + n_inputs)`` axes (row-major) to draw on; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure the axes belong to (save it with ``fig.savefig``).
+    """
+    n_out, n_in = analysis.cross_correlation.shape[:2]
+    if ax is None:
+        fig, axes = _figure(n_out, 1 + n_in, height=2.6)
+        fig.set_size_inches(max(8.0, 4.0 * (1 + n_in)), 0.6 + 2.6 * n_out)
+        flat = list(axes.ravel())
+    else:
+        flat = list(np.ravel(np.asarray(ax, dtype=object)))
+        if len(flat) != n_out * (1 + n_in):
+            raise ValueError(
+                f"plot_residuals needs {n_out * (1 + n_in)} axes (outputs x (1 + inputs)); "
+                f"got {len(flat)}."
+            )
+        fig = flat[0].figure
+    tests = list(analysis.independence)
+    for j in range(n_out):
+        a = flat[j * (1 + n_in)]
+        lags, band = analysis.lags, analysis.auto_band
+        a.fill_between(lags, -band, band, color="C0", alpha=0.15, lw=0)
+        a.vlines(lags[1:], 0, analysis.autocorrelation[j, 1:], color="C0", lw=1.5)
+        a.axhline(0, color="0.5", lw=0.6)
+        a.set_xlabel("lag k [samples]")
+        a.set_ylabel("autocorrelation")
+        a.set_title(_test_title(analysis.whiteness[j]), fontsize="small")
+        for i in range(n_in):
+            b = flat[j * (1 + n_in) + 1 + i]
+            tau = analysis.cross_lags
+            bnd = analysis.cross_band[j, i]
+            b.fill_between(tau, -bnd, bnd, color="C1", alpha=0.15, lw=0)
+            b.vlines(tau, 0, analysis.cross_correlation[j, i], color="C1", lw=1.5)
+            b.axhline(0, color="0.5", lw=0.6)
+            b.set_xlabel("lag tau [samples] (u leads for tau > 0)")
+            b.set_ylabel("cross-correlation")
+            b.set_title(_test_title(tests[j * n_in + i]), fontsize="small")
+    return fig
+
+
+def _test_title(test: Any) -> str:
+    sym = "Q" if test.name.startswith("whiteness") else "zeta"
+    rel = "<=" if test.passed else ">"
+    outcome = "passed" if test.passed else "FAILED"
+    return f"{test.name}\n{sym} = {test.statistic:.3g} {rel} {test.threshold:.3g}: {outcome}"

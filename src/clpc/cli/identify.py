@@ -81,6 +81,13 @@ def _selection_line(result: IdentifyResult) -> str:
 @sampling_options()
 @json_option()
 @save_option("Save the model (load it again with clpc simulate/compare).")
+@click.option(
+    "--report",
+    type=click.Path(dir_okay=False),
+    default=None,
+    metavar="REPORT.html",
+    help="Write an HTML report: model, parameters +- sigma, residual analysis, Bode plot.",
+)
 @record_settings()
 @collect("settings", IdentifySettings)
 def identify(settings: IdentifySettings, as_json: bool) -> None:
@@ -105,3 +112,5 @@ def identify(settings: IdentifySettings, as_json: bool) -> None:
     click.echo(format_model_summary(result.summary))
     if settings.save:
         click.echo(f"model saved to {settings.save}")
+    if settings.report:
+        click.echo(f"report written to {settings.report}")

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-__all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "residual_analysis"]
+__all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
 
 #: Lags of the tests (SITB's default ``M``); fewer on records shorter than 4 M.
 MAX_LAGS = 25
@@ -121,9 +121,14 @@ class ResidualAnalysis:
     residuals: np.ndarray
 
     @property
+    def tests(self) -> tuple[ResidualTest, ...]:
+        """Every test: the whiteness ones, then the independence ones."""
+        return (*self.whiteness, *self.independence)
+
+    @property
     def passed(self) -> bool:
         """Every test passed."""
-        return all(t.passed for t in (*self.whiteness, *self.independence))
+        return all(t.passed for t in self.tests)
 
     def __str__(self) -> str:
         head = (
@@ -131,7 +136,13 @@ class ResidualAnalysis:
             f"{self.lags.size - 1} lags, level {self.level:g}): "
             f"{'passed' if self.passed else 'FAILED'}"
         )
-        return "\n".join([head, *(f"  {t}" for t in (*self.whiteness, *self.independence))])
+        return "\n".join([head, *(f"  {t}" for t in self.tests)])
+
+
+def ljung_box(rho: np.ndarray, n: int) -> float:
+    """``Q = n (n+2) sum_{k=1}^{M} rho(k)^2 / (n-k)`` of autocorrelations ``rho(1..M)``."""
+    k = np.arange(1, rho.size + 1)
+    return float(n * (n + 2) * np.sum(rho**2 / (n - k)))
 
 
 def _correlations(x: np.ndarray, y: np.ndarray, max_lag: int) -> np.ndarray:
@@ -232,7 +243,7 @@ def residual_analysis(
     for j, name in enumerate(model.output_names):
         rho_e = _correlations(e[:, j], e[:, j], 2 * m)  # lags -2M..2M
         auto[j] = rho_e[2 * m : 3 * m + 1]
-        q = n * (n + 2) * float(np.sum(auto[j, 1:] ** 2 / (n - lags[1:])))
+        q = ljung_box(auto[j, 1:], n)
         white.append(_test(f"whiteness of {name}", q, m, level, auto[j, 1:], z / np.sqrt(n)))
         for i, inp in enumerate(model.input_names):
             cross[j, i] = _correlations(e[:, j], uu[:, i], m)

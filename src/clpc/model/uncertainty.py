@@ -254,7 +254,7 @@ def summary(model: Any) -> str:
         sigma = np.atleast_2d(parameter_std(model))
         gain_std: np.ndarray | None = dc_gain_std(model)
         how = (
-            f"+- one standard deviation ({model.info.get('covariance_method', 'stored')}, "
+            f"+- one standard deviation\n({model.info.get('covariance_method', 'stored')}, "
             f"{float(_dof(model)[0]):.4g} degrees of freedom)"
         )
     except ModelError as exc:

@@ -14,6 +14,7 @@ from clpc.io import save_model
 from clpc.lpc import LPC, OrderSelection, select_order
 from clpc.model import LinearModel, MimoMode
 from clpc.report import model_summary
+from clpc.report.identify import write_identify_report
 from clpc.workflows.common import METHODS, Method, RecordSpec
 
 __all__ = ["IdentifyResult", "IdentifySettings", "identify_file"]
@@ -45,6 +46,9 @@ class IdentifySettings:
         Multi-channel structure.
     save : str, optional
         Save the model to this JSON file.
+    report : str, optional
+        Write an HTML report (model, parameter uncertainty, residual analysis, Bode plot)
+        to this file.
     """
 
     record: RecordSpec
@@ -55,6 +59,7 @@ class IdentifySettings:
     method: Method = "robust"
     mimo: MimoMode | None = None
     save: str | None = None
+    report: str | None = None
 
     def __post_init__(self) -> None:
         if self.order != "auto":
@@ -157,4 +162,6 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
     if settings.save:
         save_model(model, settings.save)
         summary["saved"] = settings.save
+    if settings.report:
+        summary["report"] = str(write_identify_report(settings.report, model, data, summary))
     return IdentifyResult(model, summary, selection, settings.criterion)
