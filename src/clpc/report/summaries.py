@@ -38,10 +38,12 @@ def verdict_text(model: LinearModel, output: int = 0) -> str | None:
     """The identifiability verdict of one output equation in plain words.
 
     Uses :func:`clpc.verdict.fit_verdict` on the statistics in ``model.info``
-    (``determined``, ``n_null``, ``n_input_relations``...); ``None`` for models without
-    them (e.g. a CLPC steady-state model or a hand-built one).
+    (``determined``, ``n_null``, ``n_input_relations``...) and the evidence a fit stored
+    (``heldout``, ``residual_test``); ``None`` for models with neither (e.g. a CLPC
+    steady-state model or a hand-built one).
     """
-    if not all(k in model.info for k in ("n_null", "n_input_relations", "determined")):
+    has_eig = all(k in model.info for k in ("n_null", "n_input_relations", "determined"))
+    if not has_eig and "heldout" not in model.info:
         return None
     return str(fit_verdict(model, output))
 
