@@ -297,8 +297,8 @@ class LPC:
 
         try:
             cov = lpc_jackknife(mats, solve, to_monic, groups)
-        except ModelError as exc:
-            return without_covariance(model, str(exc))
+        except (ModelError, ValueError) as exc:  # no monic replicate; a noise_cov of p entries
+            return without_covariance(model, f"the jackknife could not run: {exc}")
         how = f"block jackknife over {groups} segments"
         if model.info.get("cancelled"):
             how += " (LPC solve at the reduced order)"
