@@ -221,3 +221,15 @@ def test_summary_shows_coefficients_with_sigma():
     assert "block jackknife over 20 segments" in text
     assert f"a1           {m.den[1]: .6g} +- {sigma[0]:.3g}" in text
     assert "pole 1" in text and "DC gain u -> y" in text
+
+
+def test_a_jackknife_that_cannot_run_leaves_a_note_not_a_failed_fit():
+    rng = np.random.default_rng(2)  # order 3 reduced to 1: a noise_cov of 8 entries no longer fits
+    u0 = rng.standard_normal(20000)
+    y0 = clpc.simulate_arx([1.0, -0.8], [0.5, 0.3], u0)
+    u, y = u0 + 0.05 * rng.standard_normal(20000), y0 + 0.05 * rng.standard_normal(20000)
+    m = clpc.LPC(order=3, noise_cov=np.ones(8), assess=False).fit(u, y)
+    assert m.structure.na == 1
+    assert "the jackknife could not run" in m.info["covariance_note"]
+    with pytest.raises(ModelError, match="jackknife could not run"):
+        m.confidence_interval()
