@@ -75,6 +75,18 @@ def coverage(seeds: int) -> None:
             hits.append((lo <= TRUE) & (TRUE <= hi))
         cover = np.mean(hits, axis=0)
         print(f"   {name:<34s}" + "  ".join(f"{c:.3f}" for c in cover))
+    hits = []  # two inputs, one output: 8 parameters
+    num2 = np.array([0.0, 0.3, -0.2])
+    truth = np.r_[DEN[1:], NUM, num2]
+    for seed in range(seeds):
+        rng = np.random.default_rng(seed)
+        u0 = rng.standard_normal((1500, 2))
+        y0 = clpc.simulate_arx(DEN, NUM, u0[:, 0]) + clpc.simulate_arx(DEN, num2, u0[:, 1])
+        u, y = u0 + 0.2 * rng.standard_normal((1500, 2)), y0 + 0.2 * rng.standard_normal(1500)
+        lo, hi = clpc.LPC(order=2, assess=False).fit(u, y[:, None]).confidence_interval(0.95)
+        hits.append((lo[0] <= truth) & (truth <= hi[0]))
+    cover = np.mean(hits, axis=0)
+    print(f"   {'LPC, EIV, 2 inputs (8 parameters)':<34s}" + "  ".join(f"{c:.3f}" for c in cover))
 
 
 def delta_vs_monte_carlo(seeds: int) -> None:
