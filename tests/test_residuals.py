@@ -10,7 +10,7 @@ from scipy import signal, stats
 
 import clpc
 import clpc.datasets as ds
-from clpc.model.residuals import _bartlett, _correlations
+from clpc.model.residuals import RIDGE, _bartlett, _correlations, _quadratic
 
 DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.0, 1.0, 0.5])
@@ -90,9 +90,7 @@ def test_bartlett_covariance_is_the_double_sum():
             for a in range(m + 1)
         ]
     )  # fmt: skip
-    got = _bartlett(rho_e, rho_u, m)
-    if np.linalg.eigvalsh(want).min() > 1e-3 * np.linalg.eigvalsh(want).max():
-        np.testing.assert_allclose(got, want, atol=1e-12)
+    np.testing.assert_allclose(_bartlett(rho_e, rho_u, m), want, atol=1e-12)
     # white residuals: P is the input's correlation matrix
     delta = np.zeros_like(rho_e)
     delta[2 * m] = 1.0
@@ -195,3 +193,15 @@ def test_identify_report_shows_verdict_uncertainty_and_residuals(tmp_path):
         assert f"<h2>{heading}</h2>" in page
     assert page.count("data:image/png;base64,") == 2  # residuals and Bode
     assert "the model does NOT describe the record well" in page
+
+
+def test_quadratic_form_is_the_ridged_solve_and_survives_an_indefinite_matrix():
+    rng = np.random.default_rng(11)
+    a = rng.standard_normal((6, 6))
+    pd, r = a @ a.T + np.eye(6), rng.standard_normal(6)
+    eps = RIDGE * pd.diagonal().max()
+    want = r @ np.linalg.solve(pd + eps * np.eye(6), r)
+    assert _quadratic(pd, r) == pytest.approx(want, rel=1e-10)
+    indefinite = np.diag([1.0, 1.0, -0.5])  # the eigenvalue -0.5 is clipped at eps
+    got = _quadratic(indefinite, np.array([0.0, 0.0, 1.0]))
+    assert got == pytest.approx(1.0 / (RIDGE * 1.0), rel=1e-10)

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
+from scipy import linalg, stats
 
 __all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
 
@@ -41,6 +41,9 @@ MAX_LAGS = 25
 LEVEL = 0.99
 #: Fewest residuals a test is made on.
 MIN_RESIDUALS = 20
+#: Ridge of the independence test's covariance, relative to its diagonal: the estimated
+#: correlations make ``P`` noisy, and its smallest eigenvalues must not blow ``zeta`` up.
+RIDGE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -251,7 +254,7 @@ def residual_analysis(
             cov = _bartlett(rho_e, rho_u, m)
             band[j, i] = z * np.sqrt(np.diag(cov)[np.abs(np.arange(-m, m + 1))] / n)
             r = cross[j, i, m:]  # tau = 0..M
-            zeta = n * float(r @ np.linalg.solve(cov, r))
+            zeta = n * _quadratic(cov, r)
             outside = np.abs(r) > band[j, i, m:]
             indep.append(_count(f"independence of {name} from {inp}", zeta, m + 1, level, outside))
     return ResidualAnalysis(
@@ -261,15 +264,29 @@ def residual_analysis(
 
 
 def _bartlett(rho_e: np.ndarray, rho_u: np.ndarray, m: int) -> np.ndarray:
-    """``P_ab = sum_{|k|<=M} rho_e(k) rho_u(k + b - a)`` for ``a, b = 0..M``, made positive."""
+    """``P_ab = sum_{|k|<=M} rho_e(k) rho_u(k + b - a)`` for ``a, b = 0..M``."""
     k = np.arange(-m, m + 1)
     d = np.arange(-m, m + 1)  # b - a
     p_of_d = (rho_e[2 * m + k][None, :] * rho_u[2 * m + k[None, :] + d[:, None]]).sum(axis=1)
     idx = np.arange(m + 1)
-    cov = p_of_d[m + idx[None, :] - idx[:, None]]
-    vals, vecs = np.linalg.eigh(0.5 * (cov + cov.T))
-    vals = np.maximum(vals, 1e-3 * max(float(vals.max()), 1e-300))  # estimation noise
-    return (vecs * vals) @ vecs.T
+    return p_of_d[m + idx[None, :] - idx[:, None]]
+
+
+def _quadratic(cov: np.ndarray, r: np.ndarray) -> float:
+    """``r^T (P + eps I)^-1 r`` with ``eps = RIDGE max diag P`` (estimation noise in ``P``).
+
+    A Cholesky factorisation; a ``P`` that is not positive definite even then (estimated
+    correlations can make it so) has its eigenvalues clipped at ``eps`` instead.
+    """
+    eps = RIDGE * max(float(np.max(np.diag(cov))), np.finfo(float).tiny)
+    reg = 0.5 * (cov + cov.T) + eps * np.eye(cov.shape[0])
+    try:
+        factor = linalg.cho_factor(reg)
+    except linalg.LinAlgError:
+        vals, vecs = np.linalg.eigh(reg)
+        proj = vecs.T @ r
+        return float(np.sum(proj**2 / np.maximum(vals, eps)))
+    return float(r @ linalg.cho_solve(factor, r))
 
 
 def _test(
