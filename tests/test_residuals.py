@@ -205,3 +205,17 @@ def test_quadratic_form_is_the_ridged_solve_and_survives_an_indefinite_matrix():
     indefinite = np.diag([1.0, 1.0, -0.5])  # the eigenvalue -0.5 is clipped at eps
     got = _quadratic(indefinite, np.array([0.0, 0.0, 1.0]))
     assert got == pytest.approx(1.0 / (RIDGE * 1.0), rel=1e-10)
+
+
+def test_each_output_is_judged_on_its_own_held_out_fit():
+    data = ds.load("cd_player_arm")
+    m = clpc.LPC(order=2).fit(data)
+    held = m.info["heldout"]
+    split = held["split"]
+    refit = clpc.LPC(order=2, assess=False, uncertainty=False).fit(data[:split])
+    sim = refit.simulate(data.u)
+    val = data.y[split:, 1]  # output y2 alone, against a direct computation
+    want = 100 * (1 - np.linalg.norm(val - sim[split:, 1]) / np.linalg.norm(val - val.mean()))
+    assert m.verdict(1).heldout_fit == pytest.approx(want, rel=1e-12)
+    assert m.verdict(0).heldout_fit == -np.inf  # y1's equation is unstable: its free run diverges
+    assert "free run diverges" in str(m.verdict(0))

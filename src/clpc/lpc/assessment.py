@@ -4,8 +4,8 @@
 
 * ``info["heldout"]``: the same estimator refitted on the first two thirds of the record
   and scored on the last third (:func:`clpc.lpc.heldout.score`: free-run fit %, ``k``-step
-  fit % with ``k`` one dominant time constant, stability) - how well this kind of model
-  predicts data it has not seen;
+  fit % with ``k`` one dominant time constant, stability; ``free_run_outputs`` and
+  ``kstep_outputs`` per output) - how well this kind of model predicts data it has not seen;
 * ``info["residual_test"]``: the whiteness and input-independence tests of the model's
   residuals on the whole record (:func:`clpc.model.residuals.residual_analysis`), per
   output, with statistics and thresholds.
@@ -39,11 +39,14 @@ def heldout_evidence(data: IOData, refit: Callable[[IOData], LinearModel]) -> di
         model = refit(data[:split])
         k = heldout.horizon(model, data.n_samples - split)
         sc = heldout.score(model, data, split, k)
+        free, ahead = heldout.output_scores(model, data, split, k)
     except (DataError, ModelError, ValueError, np.linalg.LinAlgError) as exc:
         return {"note": f"no held-out fit: {exc}"}
     return {
         "free_run": sc.free_run,
         "kstep": sc.kstep,
+        "free_run_outputs": free,
+        "kstep_outputs": ahead,
         "horizon": k,
         "split": split,
         "n_heldout": data.n_samples - split,

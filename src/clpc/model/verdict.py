@@ -82,6 +82,9 @@ def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, An
     held = info.get("heldout")
     if isinstance(held, dict) and "free_run" in held:
         fr, ks = float(held["free_run"]), float(held["kstep"])
+        if "free_run_outputs" in held:  # this output's own fits
+            fr = float(np.atleast_1d(held["free_run_outputs"])[output])
+            ks = float(np.atleast_1d(held["kstep_outputs"])[output])
         found["heldout_fit"], found["heldout_kstep"] = fr, ks
         poor = not fr >= MIN_HELDOUT_FIT
         msgs.append(
