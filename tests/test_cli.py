@@ -83,7 +83,7 @@ def test_identify_text_on_shipped_record():
         "poles:",
         "stable",
         "D = lambda_max",
-        "identifiability:",
+        "verdict:",
         "simulation",
         "1-step prediction",
         "10-step prediction",

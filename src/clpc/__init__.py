@@ -30,6 +30,7 @@ from clpc.lpc import (
     simulate_arx,
 )
 from clpc.model import LinearModel, ModelError, Structure, Verdict, describe_trace, fit_verdict
+from clpc.model.residuals import ResidualAnalysis, residual_analysis
 from clpc.multimodel import MultiModel
 
 _moved.install()
@@ -49,6 +50,7 @@ __all__ = [
     "MultiModel",
     "NoiseEstimate",
     "OrderSelection",
+    "ResidualAnalysis",
     "RobustRule",
     "Structure",
     "Trace",
@@ -66,6 +68,7 @@ __all__ = [
     "lpc_solve",
     "operating_point_diagnostics",
     "read_table",
+    "residual_analysis",
     "rmse",
     "save_model",
     "select_delay",

@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from clpc.model.residuals import ljung_box
+
 __all__ = ["fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"]
 
 
@@ -135,6 +137,5 @@ def whiteness_test(residuals: Any, lags: int = 20) -> WhitenessResult:
     n = e.size
     spec = np.fft.rfft(e, 2 * n)
     acf = np.fft.irfft(spec * np.conj(spec))[: lags + 1] / denom
-    k = np.arange(1, lags + 1)
-    q = n * (n + 2) * np.sum(acf[1:] ** 2 / (n - k))
+    q = ljung_box(acf[1:], n)
     return WhitenessResult(float(q), float(stats.chi2.sf(q, lags)), lags, acf[1:])

@@ -28,6 +28,7 @@ from scipy import signal
 
 from clpc.core.polynomials import monic
 from clpc.model import display, simulation
+from clpc.model import uncertainty as _unc
 from clpc.model.errors import ModelError
 from clpc.model.structure import Structure
 
@@ -213,6 +214,34 @@ class LinearModel:
         from clpc.model.verdict import fit_verdict
 
         return fit_verdict(self, output)
+
+    # ------------------------------------------- uncertainty (clpc.model.uncertainty)
+    @property
+    def covariance(self) -> np.ndarray:
+        """Covariance of ``np.r_[den[1:], num]`` per output, shape (n_outputs, q, q)."""
+        return _unc.covariance(self)
+
+    def confidence_interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
+        """``(lo, hi)`` ordered like ``np.r_[den[1:], num]`` (rows per output if several)."""
+        return _unc.confidence_interval(self, level)
+
+    def pole_std(self, output: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Poles and the std of their real and imaginary parts, shape (na, 2)."""
+        return _unc.pole_std(self, output)
+
+    def dc_gain_std(self) -> np.ndarray:
+        """Standard deviation of :meth:`dc_gain`, shape (n_outputs, n_inputs)."""
+        return _unc.dc_gain_std(self)
+
+    def frequency_response_std(
+        self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(freqs_hz, response, std of |G|, std of arg G [rad])`` (delta method)."""
+        return _unc.frequency_response_std(self, freqs, output, input)
+
+    def summary(self) -> str:
+        """Coefficients with +- one standard deviation, poles and DC gains, as text."""
+        return _unc.summary(self)
 
     # ----------------------------------------------------------------- time domain
     def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:

@@ -2,7 +2,8 @@
 
 Read top down: the result (the model, its fit, its verdict, warnings in a box), the order
 selection when the order was chosen, the model against the measured data with residuals,
-its step and Bode responses, and last, folded, the settings.
+its step and Bode responses, the parameters with +- one standard deviation, the residual
+analysis (:func:`clpc.residual_analysis`), and last, folded, the settings.
 """
 
 from __future__ import annotations
@@ -12,7 +13,9 @@ from os import PathLike
 from pathlib import Path
 from typing import Any
 
-from clpc.model import LinearModel
+from clpc.model import LinearModel, ModelError
+from clpc.model.residuals import residual_analysis
+from clpc.plotting import plot_residuals
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import model_sections, model_warnings, settings_section
 
@@ -41,6 +44,28 @@ def _selection_section(selection: Mapping[str, Any]) -> Section:
     return Section("Order selection", text=text, table=rows)
 
 
+def _uncertainty_section(model: LinearModel) -> Section:
+    """The parameters with +- one standard deviation (:meth:`LinearModel.summary`)."""
+    return Section("Parameters and their uncertainty", preformatted=model.summary())
+
+
+def _residual_section(model: LinearModel, data: Any, out: Path) -> tuple[Section, list[Path]]:
+    """The residual tests and their figure (``residuals.png``), or why they are missing."""
+    heading = "Residual analysis"
+    try:
+        res = residual_analysis(model, data.u, data.y)
+    except (ValueError, ModelError) as exc:
+        return Section(heading, text=f"not computed: {exc}"), []
+    png = out / "residuals.png"
+    plot_residuals(res, png)
+    text = (
+        "Autocorrelation of the residuals and their cross-correlation with each input; "
+        "shaded: the per-lag band at the tests' level. A model that explains the input's "
+        "effect leaves no cross-correlation at positive lags."
+    )
+    return Section(heading, text=text, preformatted=str(res), images=[png]), [png]
+
+
 def write_identify_report(
     out_dir: str | PathLike[str],
     model: LinearModel,
@@ -56,7 +81,7 @@ def write_identify_report(
     ----------
     out_dir : str or path-like
         Folder (created) for ``fit.png``, ``data.png``, ``step.png``, ``bode.png``,
-        ``pz.png`` and ``report.html``.
+        ``pz.png``, ``residuals.png`` and ``report.html``.
     model : LinearModel
     data : IOData
         The record the model was fitted on (or a validation record).
@@ -91,6 +116,10 @@ def write_identify_report(
     sections[0].text = "\n\n".join(m for m in good if m not in warnings) or None
     if selection is not None:
         sections.insert(1, _selection_section(selection))
+    sections.append(_uncertainty_section(model))
+    residuals, pngs = _residual_section(model, data, out)
+    sections.append(residuals)
+    files.extend(pngs)
     sections.append(settings_section(settings or {}))
     files.append(write_html_report(out / "report.html", title, sections))
     return files
