@@ -21,8 +21,15 @@ __all__ = [
     "check_values",
     "first_bad",
     "is_number",
+    "parse_number",
     "show",
 ]
+
+#: what a numeric cell may hold: ASCII digits, one optional sign, point and exponent, or
+#: nan/inf; never underscores ("1_000"), other scripts' digits or surrounding text
+_NUMBER = re.compile(
+    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf|infinity)", re.ASCII | re.IGNORECASE
+)
 
 
 class DataFileNotFoundError(DataError, FileNotFoundError):
@@ -35,12 +42,24 @@ def show(path: str | os.PathLike[str]) -> str:
 
 
 def is_number(text: str) -> bool:
-    """Whether ``float(text)`` succeeds (``"nan"`` and ``"inf"`` count as numbers)."""
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    """Whether ``text`` is a number for every reader (``"nan"`` and ``"inf"`` count)."""
+    return _NUMBER.fullmatch(text.strip()) is not None
+
+
+def parse_number(text: str) -> float:
+    """The value of a numeric cell: ASCII decimal (``1``, ``-2.5e-3``, ``.5``), nan or inf.
+
+    ``float`` alone would also take ``"1_000"``, Arabic-Indic or full-width digits; every
+    reader (files, ``clpc stream``) refuses those the same way.
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not such a number.
+    """
+    if _NUMBER.fullmatch(text.strip()) is None:
+        raise ValueError(f"{text!r} is not a decimal number")
+    return float(text)
 
 
 def cell_error(where: str, column: str, text: str, source: str) -> DataError:

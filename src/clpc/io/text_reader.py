@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from clpc.data import DataError
-from clpc.io.errors import cell_error, first_bad, show
+from clpc.io.errors import cell_error, first_bad, parse_number, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 from clpc.io.text_format import (
     TextFormat,
@@ -157,7 +157,7 @@ class TextReader:
     def _cell(self, text: str, no: int, c: int) -> float:
         """The value of field ``text`` in column ``c`` of line ``no`` (empty: NaN)."""
         try:
-            value = float(text) if text else math.nan
+            value = parse_number(text) if text else math.nan
         except ValueError:
             raise cell_error(f"line {no}", self.fmt.names[c], text, self.source) from None
         if not self.allow_missing and not math.isfinite(value):

@@ -24,6 +24,8 @@ def write_track_report(
     title: str = "CLPC report",
     settings: Mapping[str, Any] | None = None,
     summary: Mapping[str, Any] | None = None,
+    steady: tuple[Any, str] | None = None,
+    recent: Trace | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -40,6 +42,11 @@ def write_track_report(
         Settings shown as a table (e.g. :meth:`clpc.CLPC.config` and the file name).
     summary : mapping, optional
         :func:`trace_summary` of ``trace`` (computed when omitted).
+    steady : (LinearModel or None, str), optional
+        :func:`steady_state` of the whole record when ``trace`` is a thinned copy
+        (computed from ``trace`` when omitted).
+    recent : Trace, optional
+        The last updates, unthinned, for the table of the last 20 (default ``trace``).
 
     Returns
     -------
@@ -68,7 +75,7 @@ def write_track_report(
             images=files[:1],
         ),
     ]
-    model, source = steady_state(trace)
+    model, source = steady_state(trace) if steady is None else steady
     if model is not None:
         files += [plot_pz(model, out / "pz.png"), plot_bode(model, out / "bode.png")]
         sections.append(
@@ -78,7 +85,7 @@ def write_track_report(
                 images=files[-2:],
             )
         )
-    names, values = trace_columns(trace)
+    names, values = trace_columns(trace if recent is None else recent)
     wanted = {"index", "time", "D", "accepted", "determined", *trace.labels()}
     keep = [i for i, n in enumerate(names) if n.split(":")[-1] in wanted]
     rows: list[list[Any]] = [[names[i] for i in keep]]

@@ -11,13 +11,14 @@ from typing import Any, Literal
 import numpy as np
 
 from clpc.appraiser import CLPC
+from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
 from clpc.data import DataError
 from clpc.io import iter_table_chunks, save_model
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
-from clpc.workflows.common import AppraiserSettings, RecordSpec
+from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
 
@@ -48,6 +49,9 @@ class TrackSettings:
         Rows read from the file at a time.
     save : str, optional
         Save the steady-state model to this JSON file.
+    figure_updates : int
+        The figures show at most about twice this many updates (evenly thinned); counts,
+        convergence and the steady-state model always come from every update.
     """
 
     record: RecordSpec
@@ -56,10 +60,18 @@ class TrackSettings:
     fmt: TraceFormat = "csv"
     chunk_rows: int = 100_000
     save: str | None = None
+    figure_updates: int = 20_000
 
     def __post_init__(self) -> None:
         check_choice(self.fmt, "fmt", ("csv", "parquet"))
         check_int(self.chunk_rows, "chunk_rows", 1)
+        check_int(self.figure_updates, "figure_updates", 1)
+        record = self.record
+        if self.appraiser.sample_time is not None and record.dt is None and not record.time_col:
+            raise SettingsError(
+                "--sample-time is the rate the appraiser works at (the data are decimated to "
+                "it); give the data's own sample time with --dt (or --time) as well."
+            )
 
 
 @dataclass(frozen=True)
@@ -69,7 +81,7 @@ class TrackResult:
     Attributes
     ----------
     summary : dict
-        :func:`clpc.report.trace_summary` of the (thinned) trace.
+        :func:`clpc.report.trace_summary` of every update of the record.
     model : LinearModel or None
         The steady-state model (``None``: no update was accepted).
     model_source : str
@@ -137,6 +149,61 @@ class _Clock:
         self.seen += t.size
 
 
+#: the per-update arrays that counts, convergence, findings and the steady-state model use
+_SUMMARY_KEYS = (
+    "theta",
+    "D",
+    "c",
+    "accepted",
+    "has_model",
+    "trusted",
+    "determined",
+    "degenerate",
+    "excited",
+    "n_input_relations",
+    "stable",
+)
+
+
+_RECENT = 20  # updates in the report's table of the last updates
+
+
+def _tail(trace: Trace, n: int) -> Trace:
+    return dataclasses.replace(
+        trace,
+        index=trace.index[-n:],
+        time=trace.time[-n:],
+        rows=trace.rows[-n:],
+        not_enough_data=trace.not_enough_data[-n:],
+        arrays={k: v[-n:] for k, v in trace.arrays.items()},
+    )
+
+
+class _SummaryTrace:
+    """Every update of the run, with only the arrays :func:`trace_summary` reads.
+
+    About ``8 * (p + 5) + 8`` bytes per update for one output (p parameters): a record of
+    1e7 samples with ``cluster=12`` keeps about 8.3e5 updates, some 70 MB at p = 3.
+    """
+
+    def __init__(self) -> None:
+        self._parts: list[Trace] = []
+        self.last: Trace | None = None
+
+    def add(self, part: Trace) -> None:
+        arrays = {k: part.arrays[k] for k in _SUMMARY_KEYS if k in part.arrays}
+        self._parts.append(dataclasses.replace(part, arrays=arrays))
+        if self.last is not None and len(part) < _RECENT:
+            part = Trace.concat([self.last, part])
+        n = len(part)
+        self.last = part if n <= _RECENT else _tail(part, _RECENT)
+
+    def trace(self) -> Trace:
+        merged = Trace.concat(self._parts)
+        self._parts = [merged]
+        return merged
+
+
 @dataclass
 class _Run:
     """The state of one pass over the record."""
@@ -144,6 +211,7 @@ class _Run:
     appraiser: CLPC
     kept: ThinnedTrace
     n_raw: int
+    whole: _SummaryTrace = field(default_factory=_SummaryTrace)
 
 
 def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
@@ -163,7 +231,8 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                     )
             if run is None:
                 data_dt = clock.dt if clock is not None else record.dt
-                run = _Run(settings.appraiser.build(data_dt), ThinnedTrace(), 0)
+                kept = ThinnedTrace(settings.figure_updates)
+                run = _Run(settings.appraiser.build(data_dt), kept, 0)
             run.n_raw += values.shape[0]
             part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
             if len(part):
@@ -174,6 +243,7 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                 )
                 writer.write(part)
                 run.kept.add(part)
+                run.whole.add(part)
     assert run is not None  # iter_table_chunks raises on a file without rows
     return run
 
@@ -200,8 +270,9 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
 
     Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
     (see :func:`clpc.report.write_track_report`), and the steady-state model if asked.
-    Memory stays bounded whatever the record's length: the figures and the summary use
-    a thinned trace when there are many updates.
+    The figures use a thinned copy of the trace when there are many updates; every count,
+    the convergence point and the steady-state model come from all updates (kept in memory
+    with only the arrays they need, see :class:`_SummaryTrace`).
 
     Parameters
     ----------
@@ -229,6 +300,7 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     run = _appraise(settings, trace_file, progress)
     _check_long_enough(run, settings, trace_file)
     trace = run.kept.trace()
+    whole = run.whole.trace()
     file = settings.record.file
     report_settings = {
         "file": file,
@@ -239,12 +311,18 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         else "all",
         **run.appraiser.config(),
     }
-    summary = trace_summary(trace)
+    summary = trace_summary(whole)
+    model, source = steady_state(whole)
     report = write_track_report(
-        out, trace, title=f"CLPC report: {file}", settings=report_settings, summary=summary
+        out,
+        trace,
+        title=f"CLPC report: {file}",
+        settings=report_settings,
+        summary=summary,
+        steady=(model, source),
+        recent=run.whole.last,
     )
     files = [trace_file, *report]
-    model, source = steady_state(trace)
     if settings.save and model is not None:
         save_model(model, settings.save)
         files.append(Path(settings.save))
