@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from clpc.data import DataError
+from clpc.data.samples import NUMBER_TEXT
 
 __all__ = [
     "DataFileNotFoundError",
@@ -25,11 +26,8 @@ __all__ = [
     "show",
 ]
 
-#: what a numeric cell may hold: ASCII digits, one optional sign, point and exponent, or
-#: nan/inf; never underscores ("1_000"), other scripts' digits or surrounding text
-_NUMBER = re.compile(
-    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf|infinity)", re.ASCII | re.IGNORECASE
-)
+#: what a numeric cell may hold (the one definition, shared with IOData's text input)
+_NUMBER = NUMBER_TEXT
 
 
 class DataFileNotFoundError(DataError, FileNotFoundError):
