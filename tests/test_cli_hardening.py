@@ -295,3 +295,56 @@ def test_stream_reads_a_named_pipe_without_loss(tmp_path, sig):
     assert proc.returncode == 0, proc.stderr
     got = [json.loads(x) for x in proc.stdout.splitlines()]
     _same(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+
+
+# ------------------------------------------------------------------ simulate / compare
+@pytest.fixture
+def unstable(tmp_path):
+    from clpc.io import save_model
+    from clpc.lpc.regressors import Structure
+    from clpc.model import LinearModel
+
+    model = LinearModel(np.array([[1.0, -2.5, 0.0, 1.0]]), Structure(1, 1), 1, "siso", [0.0])
+    save_model(model, tmp_path / "unstable.json")
+    u = np.random.default_rng(0).standard_normal(3000)
+    write_table(tmp_path / "u.csv", ["u", "y"], np.column_stack([u, u]))
+    return tmp_path
+
+
+def test_simulate_of_an_unstable_model_writes_nothing(unstable):
+    out = unstable / "sim.csv"
+    res = code(
+        1, "simulate", unstable / "unstable.json", unstable / "u.csv", "-u", "u", "--out", out
+    )
+    assert "diverges" in res.output and "2.5" in res.output and "sample" in res.output
+    assert not out.exists()
+
+
+@pytest.mark.filterwarnings("error")
+def test_compare_with_a_horizon_longer_than_the_record(unstable):
+    res = code(
+        1,
+        "compare",
+        unstable / "unstable.json",
+        unstable / "u.csv",
+        "-u",
+        "u",
+        "-y",
+        "y",
+        "--k",
+        "100000",
+    )
+    assert "--k 100000" in res.output and "3000 samples" in res.output
+    res = code(
+        0,
+        "compare",
+        unstable / "unstable.json",
+        unstable / "u.csv",
+        "-u",
+        "u",
+        "-y",
+        "y",
+        "--k",
+        "50",
+    )
+    assert "diverges" in res.output
