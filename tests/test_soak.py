@@ -103,13 +103,20 @@ def test_long_stream_with_bad_lines_matches_a_batch_run_in_flat_memory():
     got = json.loads(last)
     np.testing.assert_array_equal(np.asarray(got["theta"]), ref.theta[-1])
     assert got["index"] == ref.index[-1]
-    n_bad = sum(1 for k in range(1, n) if k % EVERY == 0 and BAD[(k // EVERY) % len(BAD)].strip()
-                and not BAD[(k // EVERY) % len(BAD)].startswith("#"))
+    n_bad = sum(
+        1
+        for k in range(1, n)
+        if k % EVERY == 0
+        and BAD[(k // EVERY) % len(BAD)].strip()
+        and not BAD[(k // EVERY) % len(BAD)].startswith("#")
+    )
     assert len(reported) == n_bad
     # flat memory: after the first fifth of the run the child's RSS grows by less than 25 MB
     assert len(rss) >= 5, rss
     settled = rss[len(rss) // 5 :]
     growth_mib = (max(settled) - settled[0]) / 1024
-    print(f"\nsoak: {n} lines, {len(ref)} updates, {n_bad} bad lines, RSS {settled[0] / 1024:.0f}"
-          f" -> {max(settled) / 1024:.0f} MiB (growth {growth_mib:.1f} MiB)")
+    print(
+        f"\nsoak: {n} lines, {len(ref)} updates, {n_bad} bad lines, RSS {settled[0] / 1024:.0f}"
+        f" -> {max(settled) / 1024:.0f} MiB (growth {growth_mib:.1f} MiB)"
+    )
     assert growth_mib < 25, rss
