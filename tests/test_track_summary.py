@@ -58,3 +58,20 @@ def test_summary_counts_convergence_and_model_come_from_the_full_trace(long_reco
     # the report's model section shows the same model
     html = (tmp_path / "report.html").read_text()
     assert f"<td>{len(full)}</td>" in html.replace(" ", "")
+
+
+def test_the_whole_record_is_kept_in_104_bytes_per_update(long_record):
+    from clpc.workflows.track import _SummaryTrace
+
+    _, u, y = long_record
+    full = clpc.CLPC(3, 101, 10).run(u, y)
+    kept = _SummaryTrace()
+    kept.add(full)
+    whole = kept.trace()
+
+    def size(t):
+        per = [t.index, t.time, t.rows, t.not_enough_data, *t.arrays.values()]
+        return sum(a.nbytes for a in per) / len(t)
+
+    assert size(whole) == 104  # one output, 6 parameters: the figure in the docstring
+    assert size(whole) < size(full) / 2.9

@@ -182,8 +182,9 @@ def _tail(trace: Trace, n: int) -> Trace:
 class _SummaryTrace:
     """Every update of the run, with only the arrays :func:`trace_summary` reads.
 
-    About ``8 * (p + 5) + 8`` bytes per update for one output (p parameters): a record of
-    1e7 samples with ``cluster=12`` keeps about 8.3e5 updates, some 70 MB at p = 3.
+    104 bytes per update for one output with ``parameters_size=3`` (6 parameters), a third
+    of a full trace row: a record of 1e7 samples with ``cluster=12`` (8.3e5 updates) keeps
+    about 87 MB.
     """
 
     def __init__(self) -> None:
