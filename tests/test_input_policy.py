@@ -143,7 +143,7 @@ def test_clear_errors_for_careless_arguments():
     with pytest.raises(DataError, match="complex"):
         a.step(1 + 2j, 1)
     assert len(a.push(np.empty(0), np.empty(0))) == 0  # an empty chunk of a stream is fine
-    with pytest.raises(DataError, match="non-finite value.*NaN at sample index 1"):
+    with pytest.raises(DataError, match=r"non-finite value.*NaN at sample index 1"):
         IOData([1.0, None, 2.0], [1.0, 2.0, 3.0])
     with pytest.raises(DataError, match="not finite at sample 1"):
         CLPC().push(np.array([1.0, None, 2.0], dtype=object), [1.0, 2.0, 3.0])
