@@ -108,6 +108,9 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     """  # noqa: D301
     show = progress if progress is not None else sys.stderr.isatty()
     result = track_file(settings, _progress_bar(settings.record.file) if show else None)
-    if settings.save and result.model is None:
-        click.echo("no update was accepted: there is no model to save", err=True)
     _print_result(result)
+    if settings.save and result.model is None:
+        raise click.ClickException(
+            f"no update was accepted: there is no model to save to {settings.save} (the "
+            "trace and the report were written); see the findings above."
+        )

@@ -46,8 +46,13 @@ def _open_source(
     delimiter: str | None,
     header: bool | None,
     allow_missing: bool,
+    whole: bool = False,
 ) -> _Source:
-    """Check the file, resolve the columns and pick the reader of the file's format."""
+    """Check the file, resolve the columns and pick the reader of the file's format.
+
+    ``whole``: every value will be held at once (:func:`read_table`); numpy files larger
+    than the load limit are refused before anything is loaded.
+    """
     p = check_file(path)
     kind = file_kind(p)
     if kind == "text":
@@ -55,9 +60,9 @@ def _open_source(
     elif kind == "parquet":
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
-        names, chunks = npy_source(p, columns, allow_missing)
+        names, chunks = npy_source(p, columns, allow_missing, whole)
     else:
-        names, chunks = npz_source(p, columns, allow_missing)
+        names, chunks = npz_source(p, columns, allow_missing, whole)
     return _Source(p, names, chunks)
 
 
@@ -115,7 +120,7 @@ def read_table(
     ImportError
         Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
-    src = _open_source(path, columns, delimiter, header, allow_missing)
+    src = _open_source(path, columns, delimiter, header, allow_missing, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
     for values, where in src.chunks(_READ_CHUNK):
@@ -157,9 +162,9 @@ def iter_table_chunks(
         Rows per chunk (>= 1). Parquet and ``.npy``/``.npz`` chunks have exactly
         ``chunk_rows`` rows (the last one fewer); a text chunk holds the data rows among
         ``chunk_rows`` consecutive lines (fewer when blank or comment lines occur).
-        Text, Parquet and ``.npy`` files are read piece by piece (``.npy`` memory-mapped);
-        a ``.npz`` file (a zip archive) and the pandas fallback for Parquet are loaded
-        whole and then sliced.
+        Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
+        memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
+        array in Fortran order and the pandas fallback for Parquet are loaded whole.
     columns, delimiter, header, allow_missing
         As for :func:`read_table`.
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from clpc.core import rules
 from clpc.data import DataError, IOData, as_iodata
+from clpc.data.samples import check_spread
 from clpc.lpc import assessment
 from clpc.lpc.reduction import reduce_model
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
@@ -229,6 +230,8 @@ class LPC:
             Invalid data, too few samples, or a record in which nothing varies.
         """
         data = as_iodata(u, y, dt)
+        if self.noise_cov is None and self.noise_ratio is None:
+            check_spread(data.u, data.y, self.scaling)
         structure = self.structure()
         mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
         check_mode(mode, data.n_inputs, data.n_outputs)

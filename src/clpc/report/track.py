@@ -86,6 +86,8 @@ def write_track_report(
     data: Any = None,
     data_note: str = "",
     data_t0: float = 0.0,
+    steady: tuple[Any, str] | None = None,
+    recent: Trace | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -109,6 +111,11 @@ def write_track_report(
         Where ``data`` comes from (e.g. "the last 4000 samples of the record").
     data_t0 : float
         Time of ``data``'s first sample in the record (the fit figure's time axis).
+    steady : (LinearModel or None, str), optional
+        :func:`steady_state` of the whole record when ``trace`` is a thinned copy
+        (computed from ``trace`` when omitted).
+    recent : Trace, optional
+        The last updates, unthinned, for the table of the last 20 (default ``trace``).
 
     Returns
     -------
@@ -117,7 +124,7 @@ def write_track_report(
     """
     out = Path(out_dir)
     summary = trace_summary(trace) if summary is None else summary
-    model, source = steady_state(trace)
+    model, source = steady_state(trace) if steady is None else steady
     warnings = trace_warnings(trace, summary)
     if model is not None:
         warnings += model_warnings(model)
@@ -149,7 +156,7 @@ def write_track_report(
             images=[(trace_png, "the trace")],
         )
     )
-    names, values = trace_columns(trace)
+    names, values = trace_columns(trace if recent is None else recent)
     wanted = {"index", "time", "D", "accepted", "determined", *trace.labels()}
     keep = [i for i, n in enumerate(names) if n.split(":")[-1] in wanted]
     rows: list[list[Any]] = [[names[i] for i in keep]]
