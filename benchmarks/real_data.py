@@ -14,6 +14,9 @@ Methods:
 * ``LPC std``: ``clpc.LPC(order=N, scaling="std", cancel=False)``, the old rule in the new
   code;
 * ``ARX``: ``clpc.ARX(order=N)``, least squares;
+* ``OE``: ``clpc.OE(order=N)``, output error (simulation-error least squares, stable);
+* ``auto``: ``clpc.identify(u, y, order=N, nk=0).model``, the best of LPC new, ARX and OE on
+  the last third of the estimation part (it never sees the validation part);
 * ``LPC before``: ``clpc.LPC(order=N)`` of the package before the change (commit 7df4cf5,
   checked out at ``--baseline``), fitted in a subprocess that returns the parameters as
   JSON; the model is rebuilt and scored by the same code as the others.
@@ -49,7 +52,11 @@ ORDERS = (2, 3, 4, 5)
 K = 10
 TOL = 1e-9
 W = ("sim", "k10")
-NEW = ("LPC new", "LPC paper", "LPC std", "ARX")
+NEW = ("LPC new", "LPC paper", "LPC std", "ARX", "OE", "auto")
+#: the estimators ``auto`` chooses from (``clpc.identify``)
+BASE = ("LPC new", "ARX", "OE")
+#: ``auto`` must be within this many points of the best of BASE (free run)
+AUTO_POINTS = 1.0
 BEFORE = "LPC before"
 
 
@@ -188,6 +195,29 @@ def median(vals: list[float]) -> str:
     return f"{m:.1f}" if np.isfinite(m) else "-inf"
 
 
+# ====================================================================== auto
+def auto_report(rows: list[dict], picks: dict[str, int]) -> None:
+    """How ``auto`` (``clpc.identify``) does against the best of LPC new, ARX and OE."""
+    n = len(rows)
+    gaps, misses, bad = [], [], 0
+    for r in rows:
+        top = max(r[m]["sim"] for m in BASE)
+        gap = top - r["auto"]["sim"] if np.isfinite(top) else 0.0
+        gaps.append(gap)
+        if gap > AUTO_POINTS:
+            misses.append(f"{r['label']} N={r['N']} ({gap:.1f})")
+        stable_exists = any(r[m]["status"] != "unstable" for m in BASE)
+        bad += stable_exists and r["auto"]["status"] == "unstable"
+    finite = [g for g in gaps if np.isfinite(g)]
+    print(
+        f"auto vs the best of {', '.join(BASE)} (free run): within {AUTO_POINTS:g} point in "
+        f"{n - len(misses)}/{n} rows, largest shortfall {max(finite):.1f} points"
+        + (f"; more than {AUTO_POINTS:g} point behind in: {'; '.join(misses)}" if misses else "")
+    )
+    print(f"auto unstable although a stable candidate existed: {bad}/{n} rows")
+    print(f"auto chose: {', '.join(f'{k} {v}' for k, v in sorted(picks.items()))}")
+
+
 # ====================================================================== run
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -203,6 +233,7 @@ def main(argv: list[str] | None = None) -> int:
     methods = NEW + ((BEFORE,) if have_before else ())
     before = baseline_models(recs, args.baseline) if have_before else None
     rows: list[dict] = []  # one per record, output and order
+    picks: dict[str, int] = {}  # how often auto chose each estimator
     for i, (name, ue, ye, uv, yv, outs) in enumerate(recs):
         mode = mimo(ue.shape[1], ye.shape[1])
         for o, order in enumerate(ORDERS):
@@ -211,6 +242,7 @@ def main(argv: list[str] | None = None) -> int:
                 "LPC paper": clpc.LPC(order=order, method="paper", mimo=mode),
                 "LPC std": clpc.LPC(order=order, scaling="std", cancel=False, mimo=mode),
                 "ARX": clpc.ARX(order=order, mimo=mode),
+                "OE": clpc.OE(order=order, mimo=mode),
             }
             models: dict[str, clpc.LinearModel | str] = {}
             for label, est in estimators.items():
@@ -218,6 +250,12 @@ def main(argv: list[str] | None = None) -> int:
                     models[label] = est.fit(ue, ye)
                 except (clpc.ModelError, clpc.DataError) as exc:
                     models[label] = f"{type(exc).__name__}: {exc}"
+            try:
+                chosen = clpc.identify(ue, ye, order=order, nk=0, mimo=mode)
+                models["auto"] = chosen.model
+                picks[chosen.estimator] = picks.get(chosen.estimator, 0) + 1
+            except (clpc.ModelError, clpc.DataError) as exc:
+                models["auto"] = f"{type(exc).__name__}: {exc}"
             if before is not None:
                 models[BEFORE] = before[i][o]
             scores = {m: score(models[m], uv, yv, order) for m in methods}
@@ -232,8 +270,9 @@ def main(argv: list[str] | None = None) -> int:
 
     n = len(rows)
     best = dict.fromkeys(methods, 0)
+    rivals = [m for m in methods if m != "auto"]  # auto copies one of them
     for r in rows:
-        top = max(round(r[m]["sim"], 1) for m in methods)
+        top = max(round(r[m]["sim"], 1) for m in rivals)
         if np.isfinite(top):
             for m in methods:
                 best[m] += round(r[m]["sim"], 1) == top
@@ -279,6 +318,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{sum(x < 0 for x in d[0])} rows, k{K} better/worse in {sum(x > 0 for x in d[1])}/"
             f"{sum(x < 0 for x in d[1])} rows (of {n}; an unstable free run counts as -inf)"
         )
+    auto_report(rows, picks)
     n_c = sum(r["cancel"] > 0 for r in rows)
     print(f"new default cancelled pole/zero factors in {n_c}/{n} rows\n")
     print("channel std on the estimation part (raw-unit TLS weighs them as they are):\n")

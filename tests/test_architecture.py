@@ -25,6 +25,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("clpc.lpc",),
     ("clpc.appraiser",),
     ("clpc.analysis",),
+    ("clpc.multimodel",),
     ("clpc.io", "clpc.datasets"),
     ("clpc.plants",),
     ("clpc.plotting", "clpc.report"),

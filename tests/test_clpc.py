@@ -123,7 +123,7 @@ def test_unconverged_steady_state_raises():
     with pytest.raises(ValueError, match="never became quasi-constant"):
         trace.steady_state_model(conv)
     model = trace.steady_state_model(conv, allow_unconverged=True)
-    np.testing.assert_allclose(model.theta[0], trace.theta[np.flatnonzero(trace.accepted)[-1]])
+    np.testing.assert_allclose(model.theta, trace.theta[np.flatnonzero(trace.accepted)[-1]])
 
 
 # ---------------------------------------------------------------- streaming == batch

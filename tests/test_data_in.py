@@ -172,6 +172,52 @@ def test_fast_path_keeps_the_line_and_column_messages(tmp_path, line, pattern):
             list(iter_table_chunks(path, 3, fast=fast))
 
 
+#: cells pyarrow parses differently from clpc's one number syntax, and ordinary ones
+SYNTAX_CELLS = [
+    "1_000",
+    "\u0661\u0662",
+    "\uff11\uff12",
+    "0x10",
+    "1d5",
+    "1.5f",
+    "nan(1)",
+    "1e400",
+    "1e-400",
+    "-inf",
+    "Infinity",
+    "nan",
+    "+1.5",
+    ".5",
+    "5.",
+    " 2.5",
+    "0.1e+3",
+    "00012",
+    "",
+]
+
+
+@pytest.mark.parametrize("allow_missing", [False, True])
+@pytest.mark.parametrize("cell", SYNTAX_CELLS)
+def test_fast_path_applies_the_one_number_syntax(tmp_path, cell, allow_missing):
+    """Fast and plain readers agree with :func:`clpc.io.errors.parse_number` on every cell."""
+    from clpc.io.errors import parse_number
+
+    path = tmp_path / "s.csv"
+    path.write_text("a,b\n1,2\n3,4\n5," + cell + "\n7,8\n", encoding="utf-8")
+    try:
+        value = parse_number(cell) if cell else np.nan  # an empty cell is a missing sample
+    except ValueError:
+        value = None
+    refused = value is None or (not allow_missing and not np.isfinite(value))
+    for fast in (True, False):
+        if refused:
+            with pytest.raises(DataError, match=r"line 4, column 'b'"):
+                read_table(path, allow_missing=allow_missing, fast=fast)
+        else:
+            got = read_table(path, allow_missing=allow_missing, fast=fast).data
+            np.testing.assert_array_equal(got, [[1, 2], [3, 4], [5, value], [7, 8]])
+
+
 def test_comments_and_blank_lines_fall_back_to_the_plain_reader(tmp_path):
     path = tmp_path / "c.csv"
     path.write_text("# a comment\na,b\n1,2\n\n3,4 # note\n# more\n5,6\n")

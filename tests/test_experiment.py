@@ -69,8 +69,38 @@ def test_every_claim_has_a_verdict_for_both_commands(run: tuple[dict[str, Any], 
     for claim in run[0]["claims"]:
         for name in ("ramp", "rich"):
             if name in claim:
-                assert claim[name]["verdict"] in verdicts
-                assert claim[name]["numbers"]
+                res = claim[name]
+                assert res["verdict"] in verdicts
+                assert res["numbers"] and res["criterion"] and res["why"]
+                # a claim not reproduced says why, in one sentence from the measurements
+                assert bool(res.get("reason")) == (res["verdict"] != "reproduced")
+
+
+def test_report_gives_results_first_and_settings_last(run: tuple[dict[str, Any], Path]) -> None:
+    report = (run[1] / "report.md").read_text()
+    verdicts, settings_at = report.index("## Verdicts at a glance"), report.index("## Settings")
+    assert verdicts < report.index("## Fig. 5") < settings_at
+    assert "\n## " not in report[settings_at + 3 :]  # the settings section is the last
+    for claim in run[0]["claims"]:
+        for name in ("ramp", "rich"):
+            if name in claim:
+                assert claim[name]["criterion"] in report
+                if claim[name].get("reason"):
+                    assert claim[name]["reason"] in report
+
+
+def test_torque_estimate_tracks_on_the_ramp_without_coulomb_friction(
+    run: tuple[dict[str, Any], Path],
+) -> None:
+    """The cause check of Figs. 13-14: the same ramp, seed and settings, no Coulomb friction."""
+    smooth = run[0]["torque_without_friction"]
+    assert smooth["torque_fit"] > 80.0
+    e = smooth["torque_error"]
+    assert e["rms_last_second"] <= 1.5 * smooth["torque_noise_level"]
+    assert smooth["torque_noise_level"] > 0.0
+    # with the friction the best linear estimate of the torque from the position falls short
+    ramp = run[0]["commands"]["ramp"]["actuator"]
+    assert ramp["torque_linear_bound"] < 80.0 < smooth["torque_fit"]
 
 
 # ---------------------------------------------------------------- the paper's claims
@@ -179,8 +209,8 @@ def test_extended_ramp_leaves_nothing_to_identify(run: tuple[dict[str, Any], Pat
 def test_decimate_matches_the_appraiser(rng: np.random.Generator) -> None:
     u = np.cumsum(rng.standard_normal(3000)) * 0.01
     y = signal.lfilter([0.0, 0.2], [1.0, -0.8], u) + 1e-3 * rng.standard_normal(3000)
-    fast = clpc.CLPC(3, 60, 12, 0.01).run(u, y, dt=0.001)
-    slow = clpc.CLPC(3, 60, 12, 0.01).run(decimate(u, 10), decimate(y, 10), dt=0.01)
+    fast = clpc.CLPC(3, 60, 12, decimate_to=0.01).run(u, y, dt=0.001)
+    slow = clpc.CLPC(3, 60, 12, decimate_to=0.01).run(decimate(u, 10), decimate(y, 10), dt=0.01)
     np.testing.assert_array_equal(fast.index, slow.index)
     np.testing.assert_allclose(fast.theta, slow.theta, atol=1e-12)
 
@@ -213,7 +243,7 @@ def test_free_run_reproduces_noise_free_data(make_model, rich_input) -> None:
 def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> None:
     u = rich_input(1500)
     y = siso2.output(u)
-    trace = clpc.CLPC(3, 100, 12, 1.0).run(u, y)
+    trace = clpc.CLPC(3, 100, 12, dt=1.0).run(u, y)
     for k in (1, 10):
         res = analysis.online_prediction(trace, u, y, k)
         assert res["fit"] > 100.0 - 1e-6

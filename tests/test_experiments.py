@@ -45,12 +45,12 @@ def test_lpc_fits_several_experiments_without_crossing_a_boundary(two):
     ref = ref / np.linalg.norm(ref) * np.sign(ref[0])
     model = clpc.LPC(order=2, nk=1, method="paper", cancel=False).fit([d1, d2])
     np.testing.assert_allclose(np.ravel(model.theta), ref, atol=1e-10)
-    assert model.info["n_rows"][0] == rows.shape[0] == (700 - 3) + (500 - 3)
+    assert np.atleast_1d(model.info["n_rows"])[0] == rows.shape[0] == (700 - 3) + (500 - 3)
     # the naive join (one record) has 3 more rows, which straddle the boundary
     joined = clpc.LPC(order=2, nk=1, method="paper", cancel=False).fit(
         np.concatenate([d1.u, d2.u]), np.concatenate([d1.y, d2.y])
     )
-    assert joined.info["n_rows"][0] == rows.shape[0] + 3
+    assert np.atleast_1d(joined.info["n_rows"])[0] == rows.shape[0] + 3
     assert not np.allclose(np.ravel(joined.theta), ref, atol=1e-6)
 
 

@@ -4,6 +4,7 @@ scipy.signal and python-control."""
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -357,31 +358,68 @@ def test_to_scipy_with_na_less_than_nb(make_model):
 
 def test_to_control_poles_and_dcgain(model_delay):
     control = pytest.importorskip("control")
-    tf = model_delay.to_control()
-    assert tf.dt == 0.01
+    sys = model_delay.to_control(include_offset=False)
+    assert sys.dt == 0.01 and sys.ninputs == 1
     # the padded export may add poles at z = 0 (pure delays); the others are the model's
-    poles = np.asarray(tf.poles())
+    poles = np.asarray(sys.poles())
     nonzero = poles[np.abs(poles) > 1e-9]
     np.testing.assert_allclose(
         np.sort_complex(nonzero), np.sort_complex(model_delay.poles()), atol=1e-10
     )
-    np.testing.assert_allclose(control.dcgain(tf), model_delay.dc_gain()[0, 0], rtol=1e-10)
-    _, yout = control.step_response(tf, T=np.arange(40) * 0.01)
+    np.testing.assert_allclose(control.dcgain(sys), model_delay.dc_gain()[0, 0], rtol=1e-10)
+    _, yout = control.step_response(sys, T=np.arange(40) * 0.01)
     np.testing.assert_allclose(
         np.ravel(yout), model_delay.simulate(np.ones(40), include_offset=False), atol=1e-10
     )
 
 
+def _stable_miso():
+    theta = np.array([[1.0, -0.5, 0.3, 0.2], [1.0, 0.2, -1.0, 0.1]])
+    return LinearModel(
+        theta=theta,
+        structure=Structure(1, 0),
+        n_inputs=2,
+        mode="miso",
+        c=np.array([0.4, -0.3]),
+        input_names=("left", "right"),
+        output_names=("speed", "angle"),
+        dt=0.1,
+    )
+
+
 def test_to_control_mimo():
     pytest.importorskip("control")
-    theta = np.array([[1.0, -0.5, 0.3, 0.2], [1.0, 0.2, -1.0, 0.1]])
-    miso = LinearModel(
-        theta=theta, structure=Structure(1, 0), n_inputs=2, mode="miso", c=np.zeros(2)
-    )
-    tf = miso.to_control()
-    assert (tf.noutputs, tf.ninputs) == (2, 2)
-    gain = np.asarray(tf.dcgain()).reshape(2, 2)
+    miso = _stable_miso()
+    sys = miso.to_control(include_offset=False)
+    assert (sys.noutputs, sys.ninputs) == (2, 2)
+    gain = np.asarray(sys.dcgain()).reshape(2, 2)
     np.testing.assert_allclose(gain, miso.dc_gain(), rtol=1e-10)
+
+
+@pytest.mark.parametrize("which", ["siso_delay", "miso"])
+def test_to_control_keeps_names_and_offset(which, model_delay):
+    control = pytest.importorskip("control")
+    model = _stable_miso() if which == "miso" else model_delay
+    model = replace(model, c=model.c + 0.25)  # a nonzero offset for both
+    sys = model.to_control()
+    assert sys.input_labels == [*model.input_names, "offset"]
+    assert sys.output_labels == list(model.output_names)
+    n = 80
+    u = np.random.default_rng(4).standard_normal((n, model.n_inputs))
+    resp = control.forced_response(sys, np.arange(n) * model.dt, np.vstack([u.T, np.ones(n)]))
+    np.testing.assert_allclose(
+        np.atleast_2d(resp.outputs).T, model.simulate(u).reshape(n, -1), rtol=1e-10, atol=1e-12
+    )
+    # without the offset input: the deviation model
+    dev = control.forced_response(
+        model.to_control(include_offset=False), np.arange(n) * model.dt, u.T
+    )
+    np.testing.assert_allclose(
+        np.atleast_2d(dev.outputs).T,
+        model.simulate(u, include_offset=False).reshape(n, -1),
+        rtol=1e-10,
+        atol=1e-12,
+    )
 
 
 def test_exports_are_public():

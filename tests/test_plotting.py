@@ -21,6 +21,13 @@ def _is_png(path) -> bool:
     return len(data) > 1000 and data[:8] == PNG
 
 
+def _wrote(fig, path) -> bool:
+    """A plot function returned its figure and wrote it as PNG to ``path``."""
+    from matplotlib.figure import Figure
+
+    return isinstance(fig, Figure) and _is_png(path)
+
+
 @pytest.fixture(scope="module")
 def dryer():
     return ds.load("dryer")
@@ -45,24 +52,30 @@ def mimo():
 
 def test_plot_trace_marks_flagged_updates(trace, tmp_path):
     assert (~trace.accepted).any() and trace.not_enough_data.any()
-    out = plotting.plot_trace(trace, tmp_path / "sub" / "trace.png", title="dryer")
-    assert out == tmp_path / "sub" / "trace.png"
-    assert _is_png(out)
+    out = tmp_path / "sub" / "trace.png"
+    fig = plotting.plot_trace(trace, out, title="dryer")
+    assert _wrote(fig, out)
+    (ax_d,) = [a for a in fig.axes if a.get_ylabel().startswith("D (")]
+    labels = [t.get_text() for t in ax_d.get_legend().get_texts()]
+    n_bad = int((~trace.accepted).sum())
+    assert f"not accepted ({n_bad})" in labels
 
 
 def test_plot_trace_mimo(mimo, tmp_path):
     data, _ = mimo
     tr = clpc.CLPC(3, 101, 12).run(data)
-    assert _is_png(plotting.plot_trace(tr, tmp_path / "t.png"))
+    fig = plotting.plot_trace(tr, tmp_path / "t.png")
+    assert _wrote(fig, tmp_path / "t.png")
+    assert len([a for a in fig.axes if a.get_visible()]) == 2 * (1 + len(tr.labels()))
 
 
 def test_plot_compare_siso_and_mimo(dryer, model, mimo, tmp_path):
     y_hat = model.simulate(dryer.u[:, 0])
-    out = plotting.plot_compare(dryer.time, dryer.y[:, 0], y_hat, 12.5, tmp_path / "c.png")
-    assert _is_png(out)
+    fig = plotting.plot_compare(dryer.time, dryer.y[:, 0], y_hat, 12.5, tmp_path / "c.png")
+    assert _wrote(fig, tmp_path / "c.png")
     data, m2 = mimo
     y2, _, fit = report.model_response(m2, data.u, data.y, k=1)
-    out = plotting.plot_compare(
+    fig = plotting.plot_compare(
         data.time,
         data.y,
         y2,
@@ -71,8 +84,12 @@ def test_plot_compare_siso_and_mimo(dryer, model, mimo, tmp_path):
         names=["y1", "y2"],
         label="1-step prediction",
     )
-    assert _is_png(out)
-    assert _is_png(plotting.plot_compare(data.time, data.y, y2, None, tmp_path / "c3.png"))
+    assert _wrote(fig, tmp_path / "c2.png")
+    assert fig.axes[0].get_xlabel() == "time [samples]"  # the record has no sample time
+    assert _wrote(
+        plotting.plot_compare(data.time, data.y, y2, None, tmp_path / "c3.png"),
+        tmp_path / "c3.png",
+    )
 
 
 def test_plot_compare_rejects_mismatched_shapes(tmp_path):
@@ -81,16 +98,19 @@ def test_plot_compare_rejects_mismatched_shapes(tmp_path):
 
 
 def test_plot_pz_and_bode(model, mimo, tmp_path):
-    assert _is_png(plotting.plot_pz(model, tmp_path / "pz.png"))
-    assert _is_png(plotting.plot_bode(model, tmp_path / "bode.png"))
+    assert _wrote(plotting.plot_pz(model, tmp_path / "pz.png"), tmp_path / "pz.png")
+    assert _wrote(plotting.plot_bode(model, tmp_path / "bode.png"), tmp_path / "bode.png")
     data, m2 = mimo
-    assert _is_png(plotting.plot_pz(m2, tmp_path / "pz2.png"))
+    assert _wrote(plotting.plot_pz(m2, tmp_path / "pz2.png"), tmp_path / "pz2.png")
     paired = clpc.LPC(order=2, mimo="paired").fit(data)  # zero off-diagonal channels
-    assert _is_png(plotting.plot_bode(paired, tmp_path / "bode2.png"))
+    fig = plotting.plot_bode(paired, tmp_path / "bode2.png")
+    assert _wrote(fig, tmp_path / "bode2.png")
+    assert len(fig.axes[0].get_legend().get_texts()) == 2  # the two diagonal channels
 
 
 def test_html_report_embeds_or_links_images(model, tmp_path):
-    png = plotting.plot_pz(model, tmp_path / "fig" / "pz.png")
+    png = tmp_path / "fig" / "pz.png"
+    plotting.plot_pz(model, png)
     sections = [
         report.Section("Numbers <b>", text="a & b\n\nsecond", table={"x": 1.5, "y": "<z>"}),
         {
@@ -114,7 +134,7 @@ def test_model_summary_numbers(dryer, model):
     eq = s["equations"][0]
     np.testing.assert_allclose(eq["den"], model.den)
     np.testing.assert_allclose(eq["num"]["u"], model.num)
-    assert eq["D"] == pytest.approx(float(model.info["D"][0]))
+    assert eq["D"] == pytest.approx(model.info["D"])
     assert s["stable"] == model.is_stable
     k1 = clpc.kstep_fit(model, dryer.u[:, 0], dryer.y[:, 0], k=1)
     assert s["fit"]["prediction_1"][0] == pytest.approx(k1)
@@ -155,5 +175,6 @@ def test_format_fit():
 
 def test_track_report(trace, tmp_path):
     files = report.write_track_report(tmp_path, trace, title="t", settings={"a": 1})
-    assert [f.name for f in files] == ["trace.png", "pz.png", "bode.png", "report.html"]
+    names = ["step.png", "bode.png", "pz.png", "trace.png", "report.html"]
+    assert [f.name for f in files] == names
     assert all(f.stat().st_size > 0 for f in files)

@@ -20,17 +20,21 @@ from clpc._version import __version__
 
 if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on first use
     from clpc.analysis.metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
+    from clpc.analysis.operating_point import operating_point_diagnostics
     from clpc.appraiser import CLPC, Convergence, Trace
     from clpc.data import DataError, IOData, as_iodata
     from clpc.io import load_iodata, load_model, read_table, save_model, write_table
     from clpc.lpc import (
         ARX,
         LPC,
+        OE,
         DelaySelection,
+        Identification,
         NoiseEstimate,
         OrderSelection,
         RobustRule,
         estimate_noise_variances,
+        identify,
         lpc_solve,
         select_delay,
         select_order,
@@ -44,6 +48,8 @@ if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on fi
         describe_trace,
         fit_verdict,
     )
+    from clpc.model.residuals import ResidualAnalysis, residual_analysis
+    from clpc.multimodel import MultiModel
 
 _moved.install()
 
@@ -52,6 +58,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(
         ("fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"), "clpc.analysis.metrics"
     ),
+    "operating_point_diagnostics": "clpc.analysis.operating_point",
     **dict.fromkeys(("CLPC", "Convergence", "Trace"), "clpc.appraiser"),
     **dict.fromkeys(("DataError", "IOData", "as_iodata"), "clpc.data"),
     **dict.fromkeys(
@@ -61,11 +68,14 @@ _LAZY: dict[str, str] = {
         (
             "ARX",
             "LPC",
+            "OE",
             "DelaySelection",
+            "Identification",
             "NoiseEstimate",
             "OrderSelection",
             "RobustRule",
             "estimate_noise_variances",
+            "identify",
             "lpc_solve",
             "select_delay",
             "select_order",
@@ -77,6 +87,8 @@ _LAZY: dict[str, str] = {
         ("LinearModel", "ModelError", "Structure", "Verdict", "describe_trace", "fit_verdict"),
         "clpc.model",
     ),
+    **dict.fromkeys(("ResidualAnalysis", "residual_analysis"), "clpc.model.residuals"),
+    "MultiModel": "clpc.multimodel",
 }
 
 
@@ -104,14 +116,18 @@ __all__ = [
     "ARX",
     "CLPC",
     "LPC",
+    "OE",
     "Convergence",
     "DataError",
     "DelaySelection",
     "IOData",
+    "Identification",
     "LinearModel",
     "ModelError",
+    "MultiModel",
     "NoiseEstimate",
     "OrderSelection",
+    "ResidualAnalysis",
     "RobustRule",
     "Structure",
     "Trace",
@@ -122,11 +138,14 @@ __all__ = [
     "estimate_noise_variances",
     "fit_percent",
     "fit_verdict",
+    "identify",
     "kstep_fit",
     "load_iodata",
     "load_model",
     "lpc_solve",
+    "operating_point_diagnostics",
     "read_table",
+    "residual_analysis",
     "rmse",
     "save_model",
     "select_delay",

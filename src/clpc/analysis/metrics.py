@@ -134,8 +134,11 @@ def whiteness_test(residuals: Any, lags: int = 20) -> WhitenessResult:
     n = e.size
     spec = np.fft.rfft(e, 2 * n)
     acf = np.fft.irfft(spec * np.conj(spec))[: lags + 1] / denom
-    k = np.arange(1, lags + 1)
-    q = n * (n + 2) * np.sum(acf[1:] ** 2 / (n - k))
-    from scipy import stats  # scipy.stats costs ~0.5 s to import: only where it is used
+    # clpc.model loads scipy.signal and with it scipy.stats (~0.5 s): only where it is used
+    from scipy import stats
+
+    from clpc.model.residuals import ljung_box
+
+    q = ljung_box(acf[1:], n)
 
     return WhitenessResult(float(q), float(stats.chi2.sf(q, lags)), lags, acf[1:])

@@ -6,14 +6,22 @@ functions (``trace`` is a :class:`clpc.Trace`).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.spread import (
+    GAIN_SPREAD_LIMIT,
+    TREND_LIMIT,
+    gain_spread,
+    level_trend,
+    window_dc_gains,
+)
 from clpc.model import LinearModel
 
-__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model"]
+__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model", "usable"]
 
 
 @dataclass(frozen=True)
@@ -23,7 +31,7 @@ class Convergence:
     Attributes
     ----------
     converged : bool
-        Whether ``consecutive`` accepted updates in a row changed less than the tolerances.
+        Whether ``consecutive`` :func:`usable` updates in a row changed less than the tolerances.
     update : int
         Row of the trace where the quasi-constant phase starts (-1 if never).
     index : int
@@ -35,7 +43,7 @@ class Convergence:
         ``|D_j - D_{j-1}| / D_j``.
     consecutive : int
     theta_variation : float
-        After convergence: largest ``||theta_j - theta_ss||`` over accepted updates.
+        After convergence: largest ``||theta_j - theta_ss||`` over :func:`usable` updates.
     D_variation : float
         After convergence: largest ``|D_j - mean D| / mean D``.
     trusted_fraction : float
@@ -63,6 +71,20 @@ class Convergence:
 MIN_TRUSTED_FRACTION = 0.5
 
 
+def usable(trace: Any) -> np.ndarray:
+    """Updates that count for convergence and the steady state, shape ``(len(trace),)``.
+
+    Accepted, holding a model and from a trusted window, for every equation (traces
+    without a ``trusted`` column: accepted and holding a model).
+    """
+    arrays = trace.arrays
+    ok = arrays["accepted"].all(axis=1) & arrays["has_model"].all(axis=1)
+    trusted = arrays.get("trusted")
+    if trusted is not None:
+        ok = ok & trusted.all(axis=1)
+    return np.asarray(ok, dtype=bool)
+
+
 def convergence(
     trace: Any, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
 ) -> Convergence:
@@ -71,9 +93,10 @@ def convergence(
     An update is quasi-constant when every equation's accepted ``theta`` moved by less
     than ``theta_tol`` (Euclidean, unit vectors) and ``D`` by less than ``D_tol``
     (relative) since the previous update; convergence needs ``consecutive`` such
-    updates in a row.
+    updates in a row. Only updates from trusted windows count (:func:`usable`): with
+    ``guard=False`` the appraiser also accepts untrusted ones, which say nothing reliable.
     """
-    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    acc = usable(trace)
     theta = trace.arrays["theta"]
     d: np.ndarray = trace.arrays["D"]
     n = len(trace)
@@ -98,7 +121,7 @@ def convergence(
         return Convergence(False, -1, -1, *none, frac, why)
     if hits.size == 0:
         why = (
-            f"not converged: no {consecutive} accepted updates in a row moved theta by "
+            f"not converged: no {consecutive} trusted, accepted updates in a row moved theta by "
             f"less than {theta_tol:g} and D by less than {D_tol:.0%}"
         )
         return Convergence(False, -1, -1, *none, frac, why)
@@ -109,9 +132,9 @@ def convergence(
     d_mean = d[after].mean(axis=0)
     d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
     why = (
-        f"converged at update {start + 1}: {consecutive} accepted updates in a row moved "
-        f"theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; {frac:.0%} of "
-        "the windows are trusted"
+        f"converged at update {start + 1}: {consecutive} trusted, accepted updates in a row "
+        f"moved theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; "
+        f"{frac:.0%} of the windows are trusted"
     )
     return Convergence(
         True,
@@ -131,9 +154,17 @@ def convergence(
 def steady_state_model(
     trace: Any, conv: Convergence | None = None, *, allow_unconverged: bool = False
 ) -> LinearModel:
-    """The mean accepted ``theta`` after convergence (:meth:`clpc.Trace.steady_state_model`)."""
+    """The mean ``theta`` of the :func:`usable` updates after convergence.
+
+    See :meth:`clpc.Trace.steady_state_model`; unconverged with ``allow_unconverged``: the
+    last usable update (the last accepted one when no window is trusted).
+    """
     conv = conv or convergence(trace)
-    acc = np.asarray(trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1))
+    acc = usable(trace)
+    if not conv.converged and not acc.any():  # no trusted update: the last accepted one
+        acc = np.asarray(
+            trace.arrays["accepted"].all(axis=1) & trace.arrays["has_model"].all(axis=1)
+        )
     if conv.converged:
         sel = acc & (np.arange(len(trace)) >= conv.update)
     elif allow_unconverged and acc.any():
@@ -147,6 +178,7 @@ def steady_state_model(
         )
     theta = _mean_theta(trace.arrays["theta"][sel])
     c = trace.arrays["c"][sel].mean(axis=0)
+    spread = _warn_if_windows_disagree(trace, sel)
     return LinearModel(
         theta=theta,
         structure=trace.structure,
@@ -162,8 +194,40 @@ def steady_state_model(
             "scaling": trace.meta.get("scaling"),
             "guard": trace.meta.get("guard"),
             "updates_used": int(sel.sum()),
+            "gain_spread": spread,
         },
     )
+
+
+def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
+    """Warn loudly when the averaged windows' DC gains follow their output level (SISO).
+
+    Needs the windows' levels (``trace.meta["window_level"]``, stored by
+    :meth:`clpc.CLPC.run`); returns the gain spread, or None when it cannot be judged.
+    """
+    levels = trace.meta.get("window_level")
+    if trace.n_inputs != 1 or trace.n_equations != 1 or levels is None:
+        return None
+    if np.shape(levels)[0] != len(trace):  # rows added or dropped since run(): not judged
+        return None
+    gains = window_dc_gains(trace.arrays["theta"][sel][:, 0, :], trace.structure.na)
+    spread = gain_spread(gains)
+    rho = level_trend(np.asarray(levels)[sel, 0], gains)
+    if spread > GAIN_SPREAD_LIMIT and abs(rho) >= TREND_LIMIT:
+        finite = gains[np.isfinite(gains)]
+        warnings.warn(
+            "THE STEADY-STATE MODEL AVERAGES WINDOWS WHOSE MODELS CHANGE WITH THE OUTPUT "
+            f"LEVEL: their DC gains run from {np.percentile(finite, 10):.3g} to "
+            f"{np.percentile(finite, 90):.3g} (10th-90th percentile; relative spread "
+            f"{spread:.2f} > {GAIN_SPREAD_LIMIT}) and follow the level (rank correlation "
+            f"{rho:+.2f}, limit +/-{TREND_LIMIT}). A nonlinear plant does this (the average "
+            "mixes operating points and can be worse than one global fit: use "
+            "clpc.MultiModel.from_trace(trace, u, y)); so do windows too poorly excited to "
+            "fix their gain. clpc.operating_point_diagnostics(trace, u, y) tells which.",
+            UserWarning,
+            stacklevel=3,
+        )
+    return spread
 
 
 def _mean_theta(theta: np.ndarray) -> np.ndarray:

@@ -44,7 +44,8 @@ from clpc.appraiser import state as state_io
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.engine import resolve_engine
-from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
+from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite, check_noise_cov
+from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup, TraceLabels
 from clpc.core.checks import (
@@ -57,6 +58,7 @@ from clpc.core.checks import (
 )
 from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError, IOData, as_iodata
+from clpc.data.samples import check_spread
 from clpc.model.structure import Structure
 
 __all__ = ["CLPC"]
@@ -170,7 +172,7 @@ class CLPC:
         self.scaling = check_choice(scaling, "scaling", SCALINGS)
         self.mimo = mimo
         self.noise_ratio = noise_ratio
-        self.noise_cov = None if noise_cov is None else np.asarray(noise_cov, dtype=float)
+        self.noise_cov = check_noise_cov(noise_cov)
         self.rule = rule or RobustRule()
         if gate is not None and gate != guard and not guard:
             raise ValueError(
@@ -178,8 +180,11 @@ class CLPC:
                 "Pass one of them."
             )
         self.guard = check_bool(guard if gate is None else gate, "guard")
-        self.trust_rows = None if trust_rows is None else check_int(trust_rows, "trust_rows", 1)
-        self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2)
+        top = 2**31 - 1  # counts of rows: beyond this no window fits in memory anyway
+        self.trust_rows = (
+            None if trust_rows is None else check_int(trust_rows, "trust_rows", 1, top)
+        )
+        self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2, top)
         fsm.check_window(self, self.structure.n_params())  # one input: the fewest parameters
         if sample_time is not None and decimate_to is not None:
             raise ValueError(
@@ -288,8 +293,8 @@ class CLPC:
                     check_finite(np.array([[u_f]]), "u", self._n_seen)
                     check_finite(np.array([[y_f]]), "y", self._n_seen)
                 return self._keep_aside((u_f, y_f), update)
-        u = np.atleast_1d(np.asarray(u_k, dtype=np.float64))
-        y = np.atleast_1d(np.asarray(y_k, dtype=np.float64))
+        u = as_columns(u_k, "u").ravel()
+        y = as_columns(y_k, "y").ravel()
         if plain and u.shape == (self._n_in,) and y.shape == (self._n_out,) and not update:
             sample = np.concatenate([u, y])
             if not np.all(np.isfinite(sample)):
@@ -423,7 +428,8 @@ class CLPC:
         self.reset()
         if isinstance(u, np.ndarray) and isinstance(y, np.ndarray):
             # plain arrays: validated by push, without IOData's defensive copy of the record
-            u_arr, y_arr = as_columns(u, "u"), as_columns(y, "y")
+            u_arr = as_columns(u, "u", allow_empty=False)
+            y_arr = as_columns(y, "y", allow_empty=False)
             data_dt = None if dt is None else _seconds(dt, "dt")
             fsm.init_channels(self, u_arr.shape[1], y_arr.shape[1])
         else:
@@ -445,10 +451,15 @@ class CLPC:
                 f"the record's sample time is {data_dt:g} s but CLPC(dt={own:g}); they must "
                 "agree (dt is the data's sample time; decimate_to is the rate to work at)."
             )
+        if self.noise_cov is None and self.noise_ratio is None:
+            check_spread(u_arr, y_arr, self.scaling)
         self._decimator = Decimator(self._factor_for(data_dt))
         if self.sample_time is None and data_dt is not None:
             self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        return self.push(u_arr, y_arr, progress=progress)
+        trace = self.push(u_arr, y_arr, progress=progress)
+        factor = self._decimator.factor if self._decimator is not None else 1
+        attach_levels(trace, y_arr, factor)  # the windows' levels, for steady_state_model
+        return trace
 
     def _executor(self) -> ThreadPoolExecutor:
         """A thread pool kept for the appraiser's lifetime (created on first use)."""

@@ -6,6 +6,7 @@ seen), the last parameters, plus the decimation filter's state. Floats round-tri
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import asdict
 from typing import Any
@@ -30,6 +31,7 @@ __all__ = [
     "VERSION",
     "StateError",
     "config_of",
+    "digest",
     "load",
     "restore",
     "save",
@@ -71,13 +73,35 @@ def config_of(a: Any) -> dict[str, Any]:
     }
 
 
+def digest(state: dict[str, Any]) -> str:
+    """SHA-256 of a state's content (every field but ``digest``), canonical JSON."""
+    body = {k: v for k, v in state.items() if k != "digest"}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _check_digest(state: dict[str, Any]) -> None:
+    """The state is the one saved: any edit that passed the schema would change results."""
+    stored = field(state, "digest", str)
+    try:
+        fresh = digest(state)
+    except (TypeError, ValueError) as exc:
+        raise StateError(f"the state holds values JSON cannot hold: {exc}") from None
+    if stored != fresh:
+        raise StateError(
+            "state['digest'] does not match the state's content: the state was edited or "
+            "damaged after it was saved (an edited sample, counter or setting would change "
+            "the results without a word); save it again from the appraiser."
+        )
+
+
 def snapshot(a: Any) -> dict[str, Any]:
     """The state of appraiser ``a`` (see :meth:`clpc.CLPC.state_dict`)."""
     buf = a._buffer
     if buf is not None:
         buf.flush()
     dec = a._decimator
-    return {
+    out: dict[str, Any] = {
         "format": FORMAT,
         "version": VERSION,
         "config": config_of(a),
@@ -96,6 +120,8 @@ def snapshot(a: Any) -> dict[str, Any]:
         "dec_phase": 0 if dec is None else dec.phase,
         "record_dt": a._record_dt,
     }
+    out["digest"] = digest(out)
+    return out
 
 
 def restore(cls: Any, state: Any) -> Any:
@@ -108,8 +134,13 @@ def restore(cls: Any, state: Any) -> Any:
         return _restore(cls, state)
     except StateError:
         raise
-    except (TypeError, ValueError, KeyError) as exc:
+    except (TypeError, ValueError, KeyError, OverflowError, RecursionError) as exc:
         raise StateError(f"the state does not describe an appraiser: {exc}") from None
+    except MemoryError:
+        raise StateError(
+            "the state's settings (state['config']: window_size, parameters) need more memory "
+            "than is available; it is not a state this machine saved."
+        ) from None
 
 
 def _restore(cls: Any, state: Any) -> Any:
@@ -123,6 +154,7 @@ def _restore(cls: Any, state: Any) -> Any:
     if n_in is None or n_out is None:
         if n_in is not None or n_out is not None or n_seen or j_done:
             raise StateError("a state without channels (n_in, n_out) must have seen nothing.")
+        _check_digest(state)
         return a
     n_in, n_out = field(state, "n_in", int), field(state, "n_out", int)
     if n_in < 1 or n_out < 1:
@@ -150,6 +182,7 @@ def _restore(cls: Any, state: Any) -> Any:
     record_dt = state.get("record_dt")
     if record_dt is not None:
         a._record_dt = check_positive(record_dt, "state['record_dt']", "s")
+    _check_digest(state)
     return a
 
 

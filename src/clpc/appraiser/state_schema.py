@@ -16,7 +16,9 @@ import numpy as np
 
 __all__ = [
     "MAX_STATE_BYTES",
+    "LongNumber",
     "StateError",
+    "bounded_json",
     "checked_array",
     "field",
     "parse_json",
@@ -35,6 +37,19 @@ class StateError(ValueError):
     """A saved appraiser state that cannot be used; the message names the field."""
 
 
+class LongNumber:
+    """A number literal longer than :data:`MAX_NUMBER_CHARS`, kept unconverted.
+
+    Neither an int nor a float: the check of the field that holds it fails and names it.
+    """
+
+    def __init__(self, text: str) -> None:
+        self.chars = len(text)
+
+    def __repr__(self) -> str:
+        return f"<a number of {self.chars} characters; at most {MAX_NUMBER_CHARS}>"
+
+
 def _number(text: str) -> float:
     if len(text) > MAX_NUMBER_CHARS:
         raise StateError(f"a number of {len(text)} characters; at most {MAX_NUMBER_CHARS}.")
@@ -45,6 +60,64 @@ def _integer(text: str) -> int:
     if len(text) > MAX_NUMBER_CHARS:
         raise StateError(f"an integer of {len(text)} digits; at most {MAX_NUMBER_CHARS}.")
     return int(text)
+
+
+def _marked_number(text: str) -> float | LongNumber:
+    return LongNumber(text) if len(text) > MAX_NUMBER_CHARS else float(text)
+
+
+def _marked_integer(text: str) -> int | LongNumber:
+    return LongNumber(text) if len(text) > MAX_NUMBER_CHARS else int(text)
+
+
+def bounded_json(
+    text: str,
+    *,
+    max_bytes: int,
+    max_depth: int,
+    error: type[ValueError],
+    what: str,
+    constants: dict[str, float] | None = None,
+) -> Any:
+    """JSON with limits on size and nesting; too long numbers become :class:`LongNumber`.
+
+    Parameters
+    ----------
+    text : str
+        The JSON text.
+    max_bytes, max_depth : int
+        Longest text and deepest nesting of arrays and objects accepted.
+    error : type
+        The exception raised (a ``ValueError`` subclass taking one message).
+    what : str
+        What the text is, for the messages (e.g. ``"model file 'm.json'"``).
+    constants : dict, optional
+        Values of ``NaN``, ``Infinity`` and ``-Infinity`` (default: refused).
+
+    Raises
+    ------
+    error
+        Too large, nested too deeply, or not JSON (the message says where).
+    """
+    if len(text) > max_bytes:
+        raise error(f"{what} is {len(text)} bytes; at most {max_bytes} are read.")
+    if _depth(text) > max_depth:
+        raise error(f"{what} is nested deeper than {max_depth} levels; it is not one clpc wrote.")
+
+    def constant(name: str) -> float:
+        if constants is None or name not in constants:
+            raise error(f"{what} holds {name}, which is not a number allowed here.")
+        return constants[name]
+
+    try:
+        return json.loads(
+            text, parse_float=_marked_number, parse_int=_marked_integer, parse_constant=constant
+        )
+    except json.JSONDecodeError as exc:
+        raise error(
+            f"{what} is not valid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno}); "
+            "the file is corrupted or truncated - save it again."
+        ) from None
 
 
 def _depth(text: str) -> int:
@@ -112,7 +185,10 @@ def checked_array(
         raise StateError(f"state[{name!r}] must have shape {shape}; got {tuple(dims)}.")
     if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in data):
         raise StateError(f"state[{name!r}] must hold numbers only.")
-    arr = np.asarray(data, dtype=np.float64).reshape(dims)
+    try:
+        arr = np.asarray(data, dtype=np.float64).reshape(dims)
+    except OverflowError:
+        raise StateError(f"state[{name!r}] holds an integer no float can hold.") from None
     if finite and not np.all(np.isfinite(arr)):
         raise StateError(f"state[{name!r}] holds non-finite values.")
     return arr

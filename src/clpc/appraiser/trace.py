@@ -94,6 +94,12 @@ class Trace:
             return value[:, 0] if value.shape[1] == 1 else value
         raise AttributeError(name)
 
+    def _repr_html_(self) -> str:
+        """Counts, convergence, findings and the steady-state model as HTML (Jupyter)."""
+        from clpc.appraiser.display import trace_html
+
+        return trace_html(self)
+
     # ----------------------------------------------------------------- building
     @classmethod
     def concat(cls, traces: list[Trace], like: Trace | None = None) -> Trace:

@@ -30,6 +30,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "compare": ("clpc.cli.models", "compare"),
     "datasets": ("clpc.cli.info", "datasets"),
     "demo": ("clpc.cli.info", "demo"),
+    "multimodel": ("clpc.cli.multimodel", "multimodel"),
 }
 
 

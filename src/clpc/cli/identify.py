@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import click
 
 from clpc.cli.errors import ClpcCommand
@@ -12,14 +15,14 @@ from clpc.cli.options import (
     input_option,
     json_option,
     method_option,
-    nk_option,
     output_option,
     record_settings,
     sampling_options,
     save_option,
 )
 from clpc.cli.output import echo_json
-from clpc.report import format_model_summary
+from clpc.lpc.selection import ESTIMATORS, pct
+from clpc.report import format_model_summary, write_identify_report
 from clpc.workflows import IdentifyResult, IdentifySettings, identify_file
 
 __all__ = ["identify"]
@@ -40,6 +43,49 @@ def _selection_line(result: IdentifyResult) -> str:
     )
     line = f"order selection ({what}): {table} -> N={sel.best}"
     return f"{line}\n  {sel.reason}" if sel.reason else line
+
+
+class DelayType(click.ParamType):
+    """``auto`` or an int >= 0."""
+
+    name = "NK|auto"
+
+    def convert(
+        self, value: Any, param: click.Parameter | None, ctx: click.Context | None
+    ) -> int | str:
+        """``"auto"``, or the delay as an int (a usage error otherwise)."""
+        if str(value).strip().lower() == "auto":
+            return "auto"
+        try:
+            nk = int(str(value))
+        except ValueError:
+            self.fail(f"must be an int >= 0 or 'auto'; got {value!r}.", param, ctx)
+        if nk < 0:
+            self.fail(f"must be an int >= 0 or 'auto'; got {nk}.", param, ctx)
+        return nk
+
+
+def _comparison_lines(result: IdentifyResult) -> list[str]:
+    """The estimator comparison: one line per candidate and output, then the reason."""
+    found = result.comparison
+    assert found is not None
+    many = len({r["output"] for r in found.table}) > 1
+    lines = [
+        "estimator comparison (fitted on two thirds of the record, scored on the other third, "
+        f"both ways round; free run and {found.horizon}-step prediction fit %, higher is "
+        "better):"
+    ]
+    for r in found.table:
+        out = f" {r['output']}" if many else ""
+        mark = "  <- chosen" if r["chosen"] else ""
+        note = f"  ({r['note']})" if r["note"] else ""
+        lines.append(
+            f"  {r['estimator'].upper():<3} N={r['order']} nk={r['nk']}{out}: free run "
+            f"{pct(r['free_run'])}, {found.horizon}-step {pct(r['kstep'])}, "
+            f"{r['stability']}{mark}{note}"
+        )
+    lines.append(f"  reason: {found.reason}")
+    return lines
 
 
 @click.command(cls=ClpcCommand)
@@ -83,7 +129,23 @@ def _selection_line(result: IdentifyResult) -> str:
     help="Input order (each B has nb + 1 coefficients: MATLAB's arx nb is this + 1); "
     "overrides --order for B.",
 )
-@nk_option()
+@click.option(
+    "--nk",
+    type=DelayType(),
+    default="0",
+    show_default=True,
+    help="Input delay in samples (0: b0 acts at once, as in the paper; a physical plant with "
+    "no direct feed-through has nk >= 1, as MATLAB's default), or 'auto' (0..4 compared on "
+    "held-out data; implies --estimator lpc unless --estimator is given).",
+)
+@click.option(
+    "--estimator",
+    type=click.Choice(ESTIMATORS),
+    default=None,
+    help="Compare LPC, least squares (arx) and output error (oe) on held-out data, print the "
+    "table and the reason, and keep this one (auto: the best stable free run). Default: LPC "
+    "alone, no comparison.",
+)
 @method_option()
 @click.option(
     "--mimo",
@@ -94,27 +156,61 @@ def _selection_line(result: IdentifyResult) -> str:
 @sampling_options()
 @json_option()
 @save_option("Save the model (load it again with clpc simulate/compare).")
+@click.option(
+    "--report",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Also write an HTML report with figures to this folder (REPORT/report.html).",
+)
 @record_settings()
 @collect("settings", IdentifySettings)
-def identify(settings: IdentifySettings, as_json: bool) -> None:
+def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> None:
     """Identify a linear model -B(z)/A(z) from a record with batch LPC.
 
     Prints the monic transfer function (powers of z^-1), poles and stability, the degree of
     linearity D, the fit % of the free-run simulation and of 1- and 10-step predictions on
-    the same data, and whether the data determine the model.
+    the same data, and whether the data determine the model. With --estimator (or --nk
+    auto) LPC, least squares and output error are first compared on held-out data.
 
     \b
     Examples:
       clpc identify dryer.csv --input u --output y --order 2 --dt 0.08
       clpc identify run.csv -u torque -y position --order auto --time t --save m.json
       clpc identify arm.csv -u u1 -u u2 -y y1 -y y2 --json
+      clpc identify dryer.csv -u u -y y --estimator auto --nk auto
     """  # noqa: D301
     result = identify_file(settings)
     if as_json:
         echo_json(result.summary)
         return
+    if result.comparison is not None:
+        click.echo("\n".join(_comparison_lines(result)))
     if result.selection is not None:
         click.echo(_selection_line(result))
     click.echo(format_model_summary(result.summary))
     if settings.save:
         click.echo(f"model saved to {settings.save}")
+    if report:
+        click.echo(f"wrote {_write_report(settings, result, report)}")
+
+
+def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: str) -> Any:
+    """The HTML report of a fit (:func:`clpc.report.write_identify_report`)."""
+    record = settings.record
+    shown = {
+        "file": record.file,
+        "order": settings.order,
+        "nk": settings.nk,
+        "method": settings.method,
+        "mimo": settings.mimo,
+        "criterion": settings.criterion if settings.order == "auto" else None,
+    }
+    files = write_identify_report(
+        folder,
+        result.model,
+        record.load(),
+        title=f"LPC identify report: {Path(record.file).name}",
+        settings=shown,
+        selection=result.summary.get("order_selection"),
+    )
+    return files[-1]

@@ -36,6 +36,7 @@ __all__ = [
     "record_settings",
     "sampling_options",
     "save_option",
+    "stream_sampling_options",
 ]
 
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
@@ -132,6 +133,20 @@ def dt_option() -> Decorator:
         type=click.FloatRange(min=0, min_open=True),
         default=None,
         help="Sample time of the data [s] (default 1, or from --time).",
+    )
+
+
+def stream_sampling_options() -> Decorator:
+    """``--dt`` and ``--time COL`` (into ``time_col``): the sampling of standard input."""
+    return combine(
+        dt_option(),
+        click.option(
+            "--time",
+            "time_col",
+            metavar="COL",
+            default=None,
+            help="Column of sample times [s]; must be uniformly spaced.",
+        ),
     )
 
 

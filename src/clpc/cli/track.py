@@ -113,8 +113,8 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     """Run the CLPC appraiser over a record (read in chunks) and write a trace and a report.
 
     Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
-    OUT/trace.png, OUT/pz.png, OUT/bode.png and OUT/report.html. Exits 1 when --save was
-    asked for and no update was accepted (there is no model to save).
+    OUT/report.html with its figures (trace, fit, data, step, bode, pz .png). Exits 1 when
+    --save was asked for and no update was accepted (there is no model to save).
 
     \b
     Examples:
@@ -126,5 +126,7 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     result = track_file(settings, bar)
     _print_result(result)
     if settings.save and result.model is None:
-        click.echo("Error: no update was accepted: there is no model to save", err=True)
-        sys.exit(1)
+        raise click.ClickException(
+            f"no update was accepted: there is no model to save to {settings.save} (the "
+            "trace and the report were written); see the findings above."
+        )

@@ -42,7 +42,10 @@ def check_real(value: Any, name: str, unit: str = "") -> float:
     """``value`` as a finite float; booleans, strings and other objects are refused."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, REAL):
         raise ValueError(f"{name} must be a real number{_unit(unit)}; got {value!r}. Pass a float.")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an int no float holds
+        v = math.inf
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite; got {value!r}. Pass a finite float.")
     return v

@@ -72,6 +72,12 @@ TRUST_WINDOW_FRACTION = 0.5
 #: window): below it a quantized signal takes a handful of values and satisfies exact
 #: spurious relations.
 EXCITATION_QUANTA = 3.0
+#: A fit's verdict calls the model adequate only when its held-out free-run fit
+#: (:func:`clpc.lpc.assessment.heldout_evidence`) is at least this many percent and its
+#: residuals are independent of the input (:mod:`clpc.model.residuals`); below it the
+#: model describes the record poorly (the dryer record at N = 2, nk = 0: 43 %; with the
+#: order or the delay right: 85-88 %).
+MIN_HELDOUT_FIT = 60.0
 
 _EPS = 2.0**-52
 _TINY = 2.2250738585072014e-308

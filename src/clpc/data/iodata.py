@@ -269,6 +269,16 @@ class IOData:
             dt = float((first[-1] - first[0]) / (first.size - 1)) if first.size > 1 else None
         return cls(frame[ins], frame[outs], 1.0 if dt is None else dt, ins, outs, parts)
 
+    def plot(self, path: Any = None, *, title: str | None = None, ax: Any = None) -> Any:
+        """Plot every channel against time; returns the figure (needs matplotlib).
+
+        See :func:`clpc.data.plot.plot_iodata` (``path`` also writes a PNG, ``ax`` takes
+        ``n_inputs + n_outputs`` axes).
+        """
+        from clpc.data.plot import plot_iodata
+
+        return plot_iodata(self, path, title=title, ax=ax)
+
     def require_samples(self, needed: int, why: str) -> None:
         """Raise :class:`DataError` unless at least ``needed`` samples are present."""
         if self.n_samples < needed:

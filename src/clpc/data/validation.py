@@ -7,45 +7,19 @@ from typing import Any
 
 import numpy as np
 
+from clpc.data.errors import DataError
+from clpc.data.samples import as_samples
+
 __all__ = ["DataError", "channel_names", "check_dt", "check_finite", "to_2d_float"]
-
-
-class DataError(ValueError):
-    """Raised when user data cannot be used as given (a :class:`ValueError`)."""
 
 
 def to_2d_float(values: Any, name: str) -> tuple[np.ndarray, list[str] | None]:
     """Convert array-like data to a float64 array of shape (n_samples, n_channels).
 
-    Returns the array and the column names found on pandas objects (else ``None``).
+    The input policy is :func:`clpc.data.samples.as_samples`. Returns the array and the
+    column names found on pandas objects (else ``None``).
     """
-    columns: list[str] | None = None
-    if hasattr(values, "to_numpy") and hasattr(values, "columns"):  # DataFrame
-        columns = [str(c) for c in values.columns]
-        values = values.to_numpy()
-    elif hasattr(values, "to_numpy") and hasattr(values, "name"):  # Series
-        columns = [str(values.name)] if values.name is not None else None
-        values = values.to_numpy()
-    try:
-        arr = np.asarray(values)
-    except (TypeError, ValueError) as exc:  # ragged lists and the like
-        raise DataError(
-            f"{name} must be a numeric array-like; could not convert it ({exc}). "
-            "Pass a list, numpy array, pandas Series or DataFrame of numbers."
-        ) from None
-    if arr.dtype == object or not (
-        np.issubdtype(arr.dtype, np.number) or np.issubdtype(arr.dtype, np.bool_)
-    ):
-        try:
-            arr = arr.astype(np.float64)
-        except (TypeError, ValueError):
-            raise DataError(
-                f"{name} must hold numbers; got dtype {arr.dtype}. "
-                "Convert text columns to numbers (e.g. pandas.to_numeric) first."
-            ) from None
-    if np.iscomplexobj(arr):
-        raise DataError(f"{name} must be real; got complex dtype {arr.dtype}.")
-    arr = np.asarray(arr, dtype=np.float64)
+    arr, columns = as_samples(values, name)
     if arr.ndim == 0:
         raise DataError(f"{name} must be 1-D or 2-D; got a scalar. Pass one value per sample.")
     if arr.ndim == 1:
@@ -77,10 +51,12 @@ def check_finite(arr: np.ndarray, name: str, channels: Sequence[str]) -> None:
 
 def check_dt(dt: Any) -> float:
     """``dt`` as a positive finite number of seconds (:class:`DataError` otherwise)."""
+    if isinstance(dt, (bool, np.bool_, str, bytes)):
+        raise DataError(f"dt (sample time) must be a number of seconds; got {dt!r}.")
     try:
         value = float(dt)
-    except (TypeError, ValueError):
-        raise DataError(f"dt (sample time) must be a number of seconds; got {dt!r}.") from None
+    except (TypeError, ValueError, OverflowError):
+        raise DataError(f"dt (sample time) must be a number of seconds; got {dt!r:.60}.") from None
     if not np.isfinite(value) or value <= 0:
         raise DataError(
             f"dt (sample time) must be a positive finite number of seconds; got {dt!r}."

@@ -17,7 +17,17 @@ from clpc.core.polynomials import monic_many
 from clpc.experiment.settings import A0_MIN, RAMP
 from clpc.model import LinearModel
 
-__all__ = ["error_profile", "excitation", "fit", "free_run", "online_prediction", "stable_inverse"]
+__all__ = [
+    "constant_windows",
+    "error_profile",
+    "excitation",
+    "fit",
+    "free_run",
+    "inverse_noise",
+    "linear_bound",
+    "online_prediction",
+    "stable_inverse",
+]
 
 
 def stable_inverse(model: LinearModel, y: Any) -> np.ndarray:
@@ -41,11 +51,25 @@ def stable_inverse(model: LinearModel, y: Any) -> np.ndarray:
         ``u_hat[m]`` estimates ``u[m - nk]``; the last few samples lack their future and are
         less accurate. Units of the model's input.
     """
+    return _inverse_b(model, _a_of(model, y) - model.intercept[0])  # = B u
+
+
+def _a_of(model: LinearModel, y: Any) -> np.ndarray:
+    """``A(z) y`` with the outputs before ``y[0]`` equal to ``y[0]``."""
     yv = np.asarray(y, dtype=np.float64)
-    na, nk = model.structure.na, model.structure.nk
-    w = signal.lfilter(model.den, [1.0], np.r_[np.full(na, yv[0]), yv])[na:]
-    w = w - model.intercept[0]  # w = B u
-    b = model.num[nk:]
+    na = model.structure.na
+    return np.asarray(signal.lfilter(model.den, [1.0], np.r_[np.full(na, yv[0]), yv])[na:])
+
+
+def _inverse_b(model: LinearModel, w: np.ndarray) -> np.ndarray:
+    """``u`` with ``B(z) u = w``: zeros of B inside the circle forwards, outside backwards.
+
+    The forward part starts at rest (the inputs before ``w[0]`` are 0, as in
+    :meth:`LinearModel.infer_input`); the backward part starts in the steady state of the
+    last sample (the inputs after the record equal the last one), so a record that ends
+    settled has no end transient.
+    """
+    b = model.num[model.structure.nk :]
     roots = np.roots(b) if b.size > 1 else np.array([])
     outside = roots[np.abs(roots) >= 1.0]
     v = signal.lfilter([1.0], np.real(np.poly(roots[np.abs(roots) < 1.0])), w) / b[0]
@@ -54,8 +78,48 @@ def stable_inverse(model: LinearModel, y: Any) -> np.ndarray:
     c = np.real(np.poly(outside))  # prod (1 - r z^-1) = [1, c1, ..., cm]
     m = outside.size
     # backwards in time: c_m x(n - m) = v(n) - sum_{k<m} c_k x(n - k), poles 1/r inside
-    xr = signal.lfilter(np.r_[np.zeros(m), 1.0], c[::-1], v[::-1])
+    num_b, den_b = np.r_[np.zeros(m), 1.0], c[::-1]
+    zi = signal.lfilter_zi(num_b, den_b) * v[-1]
+    xr, _ = signal.lfilter(num_b, den_b, v[::-1], zi=zi)
     return np.asarray(xr[::-1])
+
+
+def inverse_noise(model: LinearModel, position_error: Any) -> np.ndarray:
+    """The part of :func:`stable_inverse` that the output's measurement error alone makes.
+
+    ``stable_inverse`` is affine in ``y``: ``stable_inverse(y + e) = stable_inverse(y) +
+    inverse_noise(e)``. Its response to ``e = y_measured - y_true`` (the resolver's noise
+    and quantisation, decimated) is the torque error no model can remove - the estimate's
+    noise level.
+
+    Parameters
+    ----------
+    model : LinearModel
+    position_error : array_like, shape (T,)
+        Measured minus true output [rad].
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        Units of the model's input [N m].
+    """
+    return _inverse_b(model, _a_of(model, position_error))
+
+
+def linear_bound(u: np.ndarray, y: np.ndarray, half_width: int = 3) -> float | None:
+    """Fit % of the best linear non-causal estimate of ``u`` from ``y`` (least squares).
+
+    ``u(n)`` is regressed on ``y(n - h) ... y(n + h)`` and a constant over the same record
+    it is scored on: an optimistic bound for any linear inverse with that support, the
+    actuator-model inverse included (``h = 3`` covers an N = 2 model's ``A(z)`` with its
+    delay). Fit on ``u[h:-h]``.
+    """
+    h = int(half_width)
+    n = y.size - 2 * h
+    cols = np.stack([y[h + s : h + s + n] for s in range(-h, h + 1)], axis=1)
+    x = np.c_[cols, np.ones(n)]
+    beta, *_ = np.linalg.lstsq(x, u[h : h + n], rcond=None)
+    return fit(u[h : h + n], x @ beta)
 
 
 def free_run(model: LinearModel, u: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -179,3 +243,24 @@ def excitation(command: np.ndarray, dt: float) -> dict[str, Any]:
         "second_difference_nonzero_fraction": float(np.mean(active)),
         "second_difference_nonzero_samples": int(np.sum(active)),
     }
+
+
+def constant_windows(trace: Trace, u: np.ndarray) -> np.ndarray:
+    """Updates whose window holds an exactly constant input (nothing to identify).
+
+    Parameters
+    ----------
+    trace : Trace
+        SISO trace of the decimated record ``u``.
+    u : ndarray, shape (T,)
+        Decimated input (the position command).
+
+    Returns
+    -------
+    ndarray of bool, shape (len(trace),)
+    """
+    lag = trace.structure.max_lag
+    first = np.maximum(trace.index - trace.rows - lag + 1, 0)
+    return np.array(
+        [np.ptp(u[a : b + 1]) == 0.0 for a, b in zip(first, trace.index, strict=True)], dtype=bool
+    )

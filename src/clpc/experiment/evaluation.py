@@ -13,16 +13,20 @@ from typing import Any
 import numpy as np
 
 from clpc.analysis.metrics import kstep_fit
+from clpc.appraiser.decimation import decimate
 from clpc.experiment.analysis import (
+    constant_windows,
     error_profile,
     excitation,
     fit,
     free_run,
+    inverse_noise,
+    linear_bound,
     online_prediction,
     stable_inverse,
 )
 from clpc.experiment.identification import appraise, identify
-from clpc.experiment.results import CommandResult, Identification
+from clpc.experiment.results import CommandResult, Identification, TorqueCheck
 from clpc.experiment.settings import (
     A0_MIN,
     EXTENDED_RAMP_DURATION,
@@ -42,7 +46,7 @@ from clpc.lpc.estimator import LPC
 from clpc.model import LinearModel, ModelError
 from clpc.plants import ServoParameters, ramp_with_saturation, simulate_servo
 
-__all__ = ["aliasing_check", "analyse_command", "extended_ramp"]
+__all__ = ["aliasing_check", "analyse_command", "extended_ramp", "torque_without_friction"]
 
 
 def _global_models(ident: Identification, method: str) -> dict[str, LinearModel]:
@@ -61,15 +65,25 @@ def _online(ident: Identification) -> dict[str, Any]:
     return {"k1_fit": one["fit"], "k10_fit": ten["fit"], "coverage": ten["coverage"]}
 
 
+def _rms_last_second(x: np.ndarray) -> float:
+    n = round(1.0 / SAMPLE_TIME)
+    return float(np.sqrt(np.mean(x[-n:] ** 2)))
+
+
 def evaluate_control_system(
-    ident: Identification, method: str, corner: float | None = None
+    ident: Identification, method: str, position_noise: np.ndarray, corner: float | None = None
 ) -> tuple[dict[str, Any], np.ndarray]:
-    """Figs. 15-17 numbers and the global LPC / least-squares comparison (control system)."""
+    """Figs. 15-17 numbers and the global LPC / least-squares comparison (control system).
+
+    ``position_noise`` is the decimated measured minus true position [rad]: its RMS over
+    the last second is the noise level the position error is judged against.
+    """
     u, y, model = ident.u, ident.y, ident.model
     y_hat = free_run(model, u, y)
     out: dict[str, Any] = {
         "model": model_summary(model),
         "position_error": error_profile(y - y_hat, SAMPLE_TIME, corner),
+        "position_noise_level": _rms_last_second(position_noise),
         "baselines": {},
     }
     models = _global_models(ident, method)
@@ -85,10 +99,48 @@ def evaluate_control_system(
     return out, y_hat
 
 
+def _window_fits(ident: Identification) -> dict[str, Any]:
+    """Torque fit of each trusted window's own model (the best a single cluster gives).
+
+    Also the best window's ``B(1)`` (``num_sum``) and the last trusted window's
+    (``last_window_num_sum``).
+    """
+    trace, u, y = ident.trace, ident.u, ident.y
+    best: dict[str, Any] = {"cluster": None, "time": None, "fit": None, "num_sum": None}
+    last_b1 = None
+    for j in np.flatnonzero(trace.trusted & trace.has_model & (trace.theta[:, 0] >= A0_MIN)):
+        model = LinearModel(
+            theta=trace.theta[j][None, :],
+            structure=trace.structure,
+            n_inputs=1,
+            mode=trace.mode,
+            c=np.atleast_1d(trace.c[j]),
+            dt=SAMPLE_TIME,
+        )
+        with np.errstate(over="ignore", invalid="ignore"):
+            f = fit(u, stable_inverse(model, y))
+        last_b1 = float(model.num.sum())
+        if f is not None and (best["fit"] is None or f > best["fit"]):
+            best = {"cluster": int(j) + 1, "time": float(trace.time[j]), "fit": f}
+            best["num_sum"] = last_b1
+    best["last_window_num_sum"] = last_b1
+    return best
+
+
 def evaluate_actuator(
-    ident: Identification, method: str, params: ServoParameters
+    ident: Identification,
+    method: str,
+    params: ServoParameters,
+    position_noise: np.ndarray,
+    corner: float | None = None,
 ) -> tuple[dict[str, Any], np.ndarray]:
-    """Figs. 13-14 numbers (estimated torque), k-step fits and the rigid-body comparison."""
+    """Figs. 13-14 numbers (estimated torque), k-step fits and the rigid-body comparison.
+
+    ``torque_noise_level`` is the RMS over the last second of the estimate's response to
+    ``position_noise`` (decimated measured minus true position, :func:`inverse_noise`);
+    ``torque_linear_bound`` the fit of the best linear estimate of the torque from the
+    position (:func:`linear_bound`); ``torque_best_window`` the best trusted window's model.
+    """
     u, y, model = ident.u, ident.y, ident.model
     out: dict[str, Any] = {"model": model_summary(model), "baselines": {}}
     try:
@@ -98,7 +150,10 @@ def evaluate_actuator(
         out["causal_inverse"] = f"refused: {exc}"
     u_hat = stable_inverse(model, y)
     out["torque_fit"] = fit(u, u_hat)
-    out["torque_error"] = error_profile(u - u_hat, SAMPLE_TIME)
+    out["torque_error"] = error_profile(u - u_hat, SAMPLE_TIME, corner)
+    out["torque_noise_level"] = _rms_last_second(inverse_noise(model, position_noise))
+    out["torque_linear_bound"] = linear_bound(u, y)
+    out["torque_best_window"] = _window_fits(ident)
     out["equivalent_damping"] = equivalent_damping(model, params.total_inertia, SAMPLE_TIME)
     for name, m in _global_models(ident, method).items():
         out["baselines"][name] = {
@@ -137,8 +192,9 @@ def analyse_command(
     rec = simulate_servo(command, sample_time=LOG_SAMPLE_TIME, params=params, seed=seed)
     control = identify(rec.position_command, rec.position, method)
     actuator = identify(rec.torque_command, rec.position, method)
-    cs, y_hat = evaluate_control_system(control, method, corner)
-    act, u_hat = evaluate_actuator(actuator, method, params)
+    noise = _position_noise(rec)
+    cs, y_hat = evaluate_control_system(control, method, noise, corner)
+    act, u_hat = evaluate_actuator(actuator, method, params, noise, corner)
     cs.update(D=d_statistics(control.trace), parameters=parameter_statistics(control))
     act.update(D=d_statistics(actuator.trace), parameters=parameter_statistics(actuator))
     summary = {
@@ -149,6 +205,31 @@ def analyse_command(
         "actuator": act,
     }
     return CommandResult(name, np.asarray(command), control, actuator, y_hat, u_hat, summary)
+
+
+def _position_noise(rec: Any) -> np.ndarray:
+    """Decimated measured minus true position [rad] (resolver noise and quantisation)."""
+    factor = round(SAMPLE_TIME / LOG_SAMPLE_TIME)
+    true = rec.true_position if rec.params.feedback_on_load else rec.motor_position
+    return np.asarray(decimate(rec.position, factor) - decimate(true, factor))
+
+
+def torque_without_friction(
+    command: np.ndarray, seed: Any, method: str, params: ServoParameters, corner: float
+) -> TorqueCheck:
+    """The actuator identification and torque estimate on the servo without Coulomb friction.
+
+    Same command, seed and settings as the main run; only ``motor_coulomb_friction`` and
+    ``load_coulomb_friction`` are 0. What changes between the two runs is what the
+    friction does.
+    """
+    smooth = params.replace(motor_coulomb_friction=0.0, load_coulomb_friction=0.0)
+    rec = simulate_servo(command, sample_time=LOG_SAMPLE_TIME, params=smooth, seed=seed)
+    actuator = identify(rec.torque_command, rec.position, method)
+    act, u_hat = evaluate_actuator(actuator, method, smooth, _position_noise(rec), corner)
+    act.pop("baselines")
+    act["parameters"] = parameter_statistics(actuator)
+    return TorqueCheck(actuator.u, u_hat, act)
 
 
 def extended_ramp(seed: Any, method: str, params: ServoParameters) -> dict[str, Any]:
@@ -167,12 +248,9 @@ def extended_ramp(seed: Any, method: str, params: ServoParameters) -> dict[str, 
     )
     rec = simulate_servo(cmd, sample_time=LOG_SAMPLE_TIME, params=params, seed=seed)
     ident = identify(rec.position_command, rec.position, method)
-    trace, lag = ident.trace, ident.trace.structure.max_lag
+    trace = ident.trace
     late = trace.time > RAMP_DURATION
-    first = np.maximum(trace.index - trace.rows - lag + 1, 0)
-    constant = np.array(
-        [np.ptp(ident.u[a : b + 1]) == 0.0 for a, b in zip(first, trace.index, strict=True)]
-    )
+    constant = constant_windows(trace, ident.u)
     return {
         "duration": EXTENDED_RAMP_DURATION,
         "updates_after_ramp_left_window": int(late.sum()),

@@ -28,12 +28,22 @@ def img(summary: dict[str, Any], number: int | str, caption: str) -> str:
 
 
 def claim_block(summary: dict[str, Any], key: str) -> str:
-    """The paper's words of claim ``key`` and its verdict and numbers per command."""
+    """Claim ``key``: the paper's words, its criterion and why, and the verdicts.
+
+    Per command: the verdict, the measured numbers and, when not reproduced, why.
+    """
     row = claim_row(summary, key)
     lines = [f"> **Paper:** {row['paper']}.\n"]
+    first = next((row[n] for n in ("ramp", "rich") if n in row), None)
+    if first is not None and "criterion" in first:
+        lines.append(f"**Criterion:** {first['criterion']} - *why:* {first['why']}.\n")
     for name in ("ramp", "rich"):
         if name in row:
-            lines.append(f"- **{name}** - *{row[name]['verdict']}*: {row[name]['numbers']}.")
+            res = row[name]
+            text = f"- **{name}** - *{res['verdict']}*: {res['numbers']}."
+            if res.get("reason"):
+                text += f" **Why not:** {res['reason']}."
+            lines.append(text)
     return "\n".join(lines) + "\n"
 
 
@@ -101,21 +111,42 @@ library's default guard would accept only trusted windows) |
 ({rich["max_velocity"]} rad/s, {rich["max_acceleration"]} rad/s^2, {rich["dwell"]} s dwell: a 2 s \
 period, the window length) + PRBS dither {rich["dither"]["amplitude"]} rad, \
 {rich["dither"]["min_hold"]} s minimum hold; {rich["duration"]:.0f} s record |
-| convergence tolerances | "quasi constant" | (theta_tol, D_tol, consecutive) tried in order: \
-{tol}; none met -> last accepted update |
+| convergence tolerances | "quasi constant" | (theta_tol, D_tol, consecutive) tried in order, \
+trusted updates only: {tol}; none met -> last trusted update |
+| servo log | - | torque logged as its mean over each 1 ms (what the motor integrates) |
 
 Seed {s["seed"]}; quick = {s["quick"]}; run time {summary["runtime_s"]:.1f} s.
 """
 
 
 def verdict_table(summary: dict[str, Any]) -> str:
-    """One row per claim: its figures and the verdict for each command."""
-    rows = ["| paper's claim | figures | ramp (Fig. 5) | rich command |", "|---|---|---|---|"]
+    """One row per claim: its figures, the criterion, and the verdict for each command."""
+    rows = [
+        "| paper's claim | figures | criterion | ramp (Fig. 5) | rich command |",
+        "|---|---|---|---|---|",
+    ]
     for c in summary["claims"]:
         figs = ", ".join(str(f) for f in c["figures"]) or "-"
-        cells = [c[n]["verdict"] if n in c else "-" for n in ("ramp", "rich")]
-        rows.append(f"| {c['paper']} | {figs} | {cells[0]} | {cells[1]} |")
+        columns = ("ramp", "rich") if "ramp" in c or "rich" in c else _other_columns(c)
+        cells = [_cell(c, n, columns) for n in columns]
+        first: dict[str, Any] = next((c[n] for n in columns if n in c), {})
+        crit = first.get("criterion", "-").replace("|", "\\|")  # a cell: escape the bars
+        cells += ["-"] * (2 - len(cells))
+        rows.append(f"| {c['paper']} | {figs} | {crit} | {cells[0]} | {cells[1]} |")
     return "\n".join(rows) + "\n"
+
+
+def _other_columns(claim: dict[str, Any]) -> tuple[str, ...]:
+    """The scenario keys of a claim judged on other records than the ramp and rich command."""
+    return tuple(k for k, v in claim.items() if isinstance(v, dict) and "verdict" in v)[:2]
+
+
+def _cell(claim: dict[str, Any], name: str, columns: tuple[str, ...]) -> str:
+    """A verdict cell, prefixed with its scenario when it is not the column's own command."""
+    if name not in claim:
+        return "-"
+    verdict = claim[name]["verdict"]
+    return verdict if columns == ("ramp", "rich") else f"{name}: {verdict}"
 
 
 def yes(flag: bool, yes: str, no: str) -> str:

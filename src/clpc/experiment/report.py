@@ -11,6 +11,7 @@ from typing import Any
 
 from clpc.experiment.claims import claims
 from clpc.experiment.markdown import img, setup_table, verdict_table
+from clpc.experiment.nonlinear import section_nonlinear
 from clpc.experiment.sections import (
     section_clusters,
     section_command,
@@ -31,10 +32,11 @@ NOTES = """## Notes and workarounds
   signals (`clpc.experiment.decimate` reproduces the appraiser's filter exactly).
 - The actuator models are non-minimum-phase (a sampling zero); the torque is estimated with the
   stable non-causal inverse, not with `infer_input(allow_unstable=True)`, which diverges.
-- With `guard=False` the appraiser accepts estimates from windows where the command is constant
-  (after a ramp has left the window), some with a0 nearly 0 (relations of the command alone):
-  the held output, and a steady-state model built from it, are then meaningless. The ramp
-  record therefore stops when the ramp leaves the window.
+- Once a ramp has left the window every window holds a constant command: nothing is left to
+  identify (see Fig. 5), so the ramp record stops when the ramp leaves the window.
+- Convergence and the steady state count trusted updates only (`clpc.appraiser.convergence.usable`);
+  Figs. 6-12 mark them with the same function the verdicts read.
+- The servo logs the torque as its mean over each logging period (what the motor integrates).
 """
 
 
@@ -46,9 +48,8 @@ def render_report(summary: dict[str, Any]) -> str:
         "Identification (a): position command -> measured position (the control system, "
         "Figs. 6-12 and 15-17). Identification (b): torque command -> measured position (the "
         "motor as actuator, Figs. 13-14). The main figures use the paper's ramp with "
-        "saturation; the same pipeline also runs on a richer command (`rich` columns).\n",
-        "## Set-up\n",
-        setup_table(summary),
+        "saturation; the same pipeline also runs on a richer command (`rich` columns). "
+        "Results first; the settings are at the end.\n",
         "## Verdicts at a glance\n",
         verdict_table(summary),
         *section_command(summary),
@@ -61,6 +62,9 @@ def render_report(summary: dict[str, Any]) -> str:
         img(summary, "rich", "Rich command: command, D, parameters and torque estimate"),
         "Same pipeline, same Table 1 settings; see the `rich` columns above.\n",
         *section_clusters(summary),
+        *section_nonlinear(summary),
         NOTES,
+        "## Settings\n",
+        setup_table(summary),
     ]
     return "\n".join(parts)

@@ -10,7 +10,7 @@ import numpy as np
 from clpc.appraiser.trace import Convergence, Trace
 from clpc.model import LinearModel
 
-__all__ = ["CommandResult", "Identification"]
+__all__ = ["CommandResult", "Identification", "TorqueCheck"]
 
 
 @dataclass
@@ -50,4 +50,17 @@ class CommandResult:
     actuator: Identification
     position_hat: np.ndarray
     torque_hat: np.ndarray
+    summary: dict[str, Any]
+
+
+@dataclass
+class TorqueCheck:
+    """The ramp's torque estimate on the servo without Coulomb friction (the cause check).
+
+    ``u`` and ``u_hat`` are the decimated torque command and its estimate [N m];
+    ``summary`` the same numbers as ``commands.ramp.actuator`` in ``summary.json``.
+    """
+
+    u: np.ndarray
+    u_hat: np.ndarray
     summary: dict[str, Any]

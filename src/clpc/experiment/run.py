@@ -23,8 +23,10 @@ is evaluated on the same decimated signals (:func:`clpc.appraiser.decimation.dec
 the appraiser's own filter).
 
 Data flow (no module imports one above it): ``settings`` -> ``results`` -> ``analysis``,
-``statistics``, ``identification`` -> ``evaluation`` -> ``claims`` -> ``markdown`` ->
-``sections`` -> ``report``; ``figures``; ``run`` (this module) calls them all.
+``statistics``, ``identification`` -> ``evaluation`` -> ``claim_checks`` -> ``claims`` ->
+``markdown`` -> ``sections`` -> ``report``; ``marks`` -> ``figure_base``,
+``figures_signals`` -> ``figures``; ``run`` (this module) calls them all. A further section
+of the demo is one more ``analyse_*`` call here, its numbers one more key of the summary.
 """
 
 from __future__ import annotations
@@ -39,8 +41,14 @@ import numpy as np
 
 from clpc.core.jsonable import jsonable
 from clpc.experiment.claims import claims
-from clpc.experiment.evaluation import aliasing_check, analyse_command, extended_ramp
+from clpc.experiment.evaluation import (
+    aliasing_check,
+    analyse_command,
+    extended_ramp,
+    torque_without_friction,
+)
 from clpc.experiment.figures import write_figures
+from clpc.experiment.nonlinear import nonlinear_claim, run_nonlinear
 from clpc.experiment.report import render_report
 from clpc.experiment.settings import (
     LOG_SAMPLE_TIME,
@@ -132,15 +140,20 @@ def run_experiment(
     ramp_fn, rich_fn = commands(ramp_duration, rich_duration, seeds[2])
     ramp = analyse_command("ramp", ramp_fn(LOG_SAMPLE_TIME), seeds[0], method, params, RAMP.corner)
     rich = analyse_command("rich", rich_fn(LOG_SAMPLE_TIME), seeds[1], method, params)
+    # the cause check of Figs. 13-14: the same ramp run on the servo without Coulomb friction
+    smooth = torque_without_friction(ramp.command_log, seeds[0], method, params, RAMP.corner)
     summary: dict[str, Any] = {
         "settings": settings_record(ramp_duration, rich_duration, quick, seed, method),
         "rigid_body": rigid_body(params, SAMPLE_TIME),
         "commands": {"ramp": ramp.summary, "rich": rich.summary},
+        "torque_without_friction": smooth.summary,
         "extended_ramp": extended_ramp(seeds[3], method, params),
         "aliasing_check": aliasing_check(rich_fn, seeds[4], method, params),
     }
     summary["claims"] = claims(summary)
-    summary["figures"] = write_figures(out, ramp, rich, quick=quick)
+    summary["nonlinear_servo"] = run_nonlinear(out, seed=seed, quick=quick)  # issue 18
+    summary["claims"].append(nonlinear_claim(summary["nonlinear_servo"]))
+    summary["figures"] = write_figures(out, ramp, rich, smooth, quick=quick)
     summary["runtime_s"] = time.perf_counter() - t_start
     summary = jsonable(summary)
     (out / "summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")

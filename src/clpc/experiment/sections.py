@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from clpc.experiment.claims import NOT_REPRODUCED, REPRODUCED, fmt, verdict_of
+from clpc.experiment.claims import NOT_REPRODUCED, REPRODUCED, fmt, fmt_poles, verdict_of
 from clpc.experiment.markdown import baseline_rows, claim_block, img, model_row, yes
 from clpc.experiment.settings import A0_MIN, D_QUASI_CONSTANT, LABELS
 
@@ -44,9 +44,8 @@ def section_command(summary: dict[str, Any]) -> list[str]:
         f"{ext['D_last']:.2g} rad^2 from a peak of {ext['D_max']:.0f}). The appraiser flags "
         f"{ext['degenerate_flagged']} of them degenerate and accepts "
         f"{ext['accepted_constant_command']} estimates from constant-command windows "
-        f"({ext['accepted_without_a0']} of all accepted estimates have a0 < {A0_MIN}), which "
-        "it then holds "
-        f"(last held theta [{theta}]). The main ramp record therefore ends at "
+        f"({ext['accepted_without_a0']} of all accepted estimates have a0 < {A0_MIN}); it "
+        f"holds theta [{theta}] at the end. The main ramp record therefore ends at "
         f"{summary['settings']['ramp']['duration']:.1f} s, when the ramp leaves the window.\n",
     ]
 
@@ -89,6 +88,19 @@ def section_parameters(summary: dict[str, Any]) -> list[str]:
             "are individually weakly identified, while the transfer function is well "
             "determined (see the fits below)."
         )
+    p_r = summary["commands"]["ramp"]["control_system"]["parameters"]
+    step = p_r.get("largest_step")
+    if step is not None:
+        st = summary["settings"]
+        gone = st["ramp"]["start"] + st["window_time"]
+        text += (
+            f" On the ramp the marker is where the convergence rule first holds (cluster "
+            f"{p_r['cluster']}); the rule does not forbid later steps, and the largest one "
+            f"({step['size']:.3f} in ||theta||, cluster {step['cluster']}, t = "
+            f"{step['time']:.2f} s) comes after the ramp's start has left the 2 s window "
+            f"(t = {gone:.2f} s): the windows then hold another part of the motion. The red "
+            "line is the mean of the trusted updates from the marker on, the band their range."
+        )
     return [
         "## Figs. 7-12 - the parameters a01, a11, a21, b01, b11, b21 per cluster\n",
         *[
@@ -124,10 +136,11 @@ def section_models(summary: dict[str, Any]) -> list[str]:
             "separate A(z) from B(z); the ramp's actuator model is not the motor."
         )
     text += (
-        " Logging the torque directly at 10 ms, without anti-alias filtering, aliases the "
-        "velocity-loop torque: the poles then come out at distance "
-        f"{alias['pole_distance_to_1']:.3f} from 1, stable: {alias['stable']} - hence "
-        "the 1 ms log decimated by the appraiser."
+        " Logged directly at 10 ms (the servo's log then averages the torque over each "
+        "10 ms, a boxcar anti-alias filter, instead of the appraiser's Butterworth on a 1 ms "
+        "log), the rich-command actuator poles come out at "
+        f"{fmt_poles(alias['poles'])}, {alias['pole_distance_to_1']:.4f} from 1, "
+        f"stable: {alias['stable']}."
     )
     return [
         "## Steady-state models\n",
@@ -149,20 +162,50 @@ def section_models(summary: dict[str, Any]) -> list[str]:
 
 
 def section_torque(summary: dict[str, Any]) -> list[str]:
-    """Figs. 13-14: experimental and estimated torque command."""
+    """Figs. 13-14: experimental and estimated torque command, and what limits the estimate."""
     act_r = summary["commands"]["ramp"]["actuator"]
-    return [
-        "## Figs. 13-14 - experimental and estimated torque command\n",
-        img(summary, 13, "Fig. 13 Experimental and estimated torque command [N m]"),
-        img(summary, 14, "Fig. 14 Torque command identification error [N m]"),
-        claim_block(summary, "torque_estimate"),
+    smooth = summary.get("torque_without_friction")
+    best = act_r["torque_best_window"]
+    text = (
         "The estimated torque is the actuator model run backwards, u = (A(z) y - k)/B(z). "
         "Sampling a double integrator puts a zero of B(z) outside the unit circle, so the "
         "causal inverse (`LinearModel.infer_input`) is unstable; for the ramp model it "
         f'answers: "{act_r["causal_inverse"]}" The figures use the stable non-causal '
         "inverse (`clpc.experiment.stable_inverse`: zeros inside the circle inverted forwards, "
-        "outside backwards in time), valid offline. A model with A(1) != 0 turns position into "
-        "a spurious torque (a spring), which shows as an offset of the estimate at rest.\n",
+        "outside backwards in time, both started at rest/settled), valid offline.\n\n"
+        "What limits it, measured: (1) the servo logs the torque as its mean over each 1 ms "
+        "(what the motor integrates); one controller sample per period put the velocity "
+        "loop's noise torque, which never moves the motor, into the log. (2) Coulomb "
+        f"friction ({summary['rigid_body']['coulomb']} N m, the whole torque of the ramp) "
+        "holds the motor while the torque changes at rest and in the hold: the best linear "
+        "estimate of this torque from this position, least squares fitted on the record "
+        f"itself, reaches {fmt(act_r['torque_linear_bound'], '.1f')} %, and the best single "
+        f"trusted window's model {fmt(best['fit'], '.1f')} % (cluster {best['cluster']}). "
+        "(3) The steady-state model averages the later windows, from which the ramp's start "
+        "has gone and whose torque gain collapses (B(1) "
+        f"{fmt(best.get('num_sum'), '.3g')} in the best window, "
+        f"{fmt(best.get('last_window_num_sum'), '.2g')} in the last): B(1) = "
+        f"{act_r['model']['num_sum']:.3g} (rigid body "
+        f"{sum(summary['rigid_body']['num']):.3g}) and A(1) = {act_r['model']['den_sum']:.2g}"
+        ", so the intercept k fitted at the windows' operating point turns into a torque "
+        f"of -k/B(1) = {fmt(act_r['model'].get('input_at_zero'), '.3f')} N m at rest."
+    )
+    if smooth is not None:
+        e = smooth["torque_error"]
+        text += (
+            " Panel (b) runs the same ramp, seed and settings on the servo without Coulomb "
+            f"friction: torque fit {fmt(smooth['torque_fit'], '.1f')} %, error RMS over the "
+            f"last second {1e3 * e['rms_last_second']:.2f} mN m against a noise level of "
+            f"{1e3 * smooth['torque_noise_level']:.2f} mN m; at rest its estimate sits at "
+            f"its own -k/B(1) = {1e3 * (smooth['model'].get('input_at_zero') or 0.0):.2f} "
+            f"mN m (mean error there {1e3 * (e.get('mean_before_ramp') or 0.0):.2f} mN m)."
+        )
+    return [
+        "## Figs. 13-14 - experimental and estimated torque command\n",
+        img(summary, 13, "Fig. 13 Experimental and estimated torque command [N m]"),
+        img(summary, 14, "Fig. 14 Torque command identification error [mN m]"),
+        claim_block(summary, "torque_estimate"),
+        text + "\n",
     ]
 
 

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
+from clpc.appraiser.convergence import usable
 from clpc.appraiser.trace import Trace
 from clpc.experiment.results import Identification
 from clpc.experiment.settings import A0_MIN, D_QUASI_CONSTANT, LABELS, WINDOW_SIZE
@@ -76,7 +77,11 @@ def d_statistics(trace: Trace) -> dict[str, Any]:
 
 
 def parameter_statistics(ident: Identification) -> dict[str, Any]:
-    """The Figs. 7-12 claim: cluster where theta becomes quasi-constant, variation after it."""
+    """The Figs. 7-12 claim: cluster where theta becomes quasi-constant, variation after it.
+
+    ``largest_step``: the largest ``||theta_j - theta_{j-1}||`` between consecutive trusted
+    updates after the marker, with the cluster and time [s] where it lands.
+    """
     conv, trace = ident.convergence, ident.trace
     theta = trace.theta
     a0 = theta[:, 0]
@@ -95,7 +100,16 @@ def parameter_statistics(ident: Identification) -> dict[str, Any]:
     }
     if conv.converged:
         after = np.arange(len(trace)) >= conv.update
-        dev = np.abs(theta[after] - ident.model.theta[0][None, :]).max(axis=0)
+        dev = np.abs(theta[after] - ident.model.theta_matrix[0][None, :]).max(axis=0)
+        used = np.flatnonzero(usable(trace) & after)
+        steps = np.linalg.norm(np.diff(theta[used], axis=0), axis=1) if used.size > 1 else []
+        if len(steps):
+            k = int(np.argmax(steps))
+            out["largest_step"] = {
+                "size": float(steps[k]),
+                "cluster": int(used[k + 1]) + 1,
+                "time": float(trace.time[used[k + 1]]),
+            }
         out.update(
             cluster=int(conv.update) + 1,
             time=float(conv.time),
@@ -109,13 +123,15 @@ def parameter_statistics(ident: Identification) -> dict[str, Any]:
 def model_summary(model: LinearModel) -> dict[str, Any]:
     """Coefficients (both conventions), poles, zeros, stability, DC gain of a SISO model.
 
-    ``den_sum`` is ``A(1)`` (0 for an integrator) and ``num_sum`` is ``B(1)``.
+    ``den_sum`` is ``A(1)`` (0 for an integrator) and ``num_sum`` is ``B(1)``; the model's
+    static map is ``y = dc_gain * u + static_offset`` (``static_offset = k / A(1)``);
+    ``input_at_zero = -k / B(1)`` is what its inverse returns for a constant ``y = 0``.
     """
     poles, zeros = model.poles(), model.zeros()
     with np.errstate(divide="ignore", invalid="ignore"):
         dc = float(model.dc_gain()[0, 0])
     return {
-        "theta": model.theta[0].tolist(),
+        "theta": model.theta_matrix[0].tolist(),
         "den": model.den.tolist(),
         "num": model.num.tolist(),
         "poles": [[float(p.real), float(p.imag)] for p in poles],
@@ -127,7 +143,24 @@ def model_summary(model: LinearModel) -> dict[str, Any]:
         "pole_distance_to_1": float(np.abs(poles - 1.0).min()),
         "den_sum": float(model.den.sum()),
         "num_sum": float(model.num.sum()),
+        "intercept": float(np.atleast_1d(model.intercept)[0]),
+        "static_offset": _static_offset(model),
+        "input_at_zero": _input_at_zero(model),
     }
+
+
+def _input_at_zero(model: LinearModel) -> float | None:
+    """``-k / B(1)``: the constant input the model needs to hold ``y = 0`` (None: B(1) = 0)."""
+    b1 = float(model.num.sum())
+    k = float(np.atleast_1d(model.intercept)[0])
+    return -k / b1 if abs(b1) > 1e-12 else None
+
+
+def _static_offset(model: LinearModel) -> float | None:
+    """``k / A(1)``: the output the model holds for a zero input (None for an integrator)."""
+    a1 = float(model.den.sum())
+    k = float(np.atleast_1d(model.intercept)[0])
+    return k / a1 if abs(a1) > 1e-12 else None
 
 
 def rigid_body(params: ServoParameters, dt: float) -> dict[str, Any]:

@@ -4,7 +4,8 @@ pyarrow parses a delimited file in C++ (several times faster than ``numpy.loadtx
 values are the same correctly rounded float64 numbers. The fast path only answers for files
 it can vouch for: a one-character delimiter, two columns or more, no compression, no blank
 line (read as a row here, so that the line numbers stay exact), every selected cell a finite
-number (unless ``allow_missing``).
+number in the one number syntax of :func:`clpc.io.errors.parse_number` (``allow_missing``:
+empty cells too).
 Anything else - a comment line, a ragged row, a text cell, an empty cell, NaN - stops it,
 and :class:`~clpc.io.text_reader.TextReader` re-reads the file with the plain reader, which
 either handles the line (comments) or raises its one-line message naming the line, the
@@ -62,19 +63,30 @@ def _whole(
     values = np.empty((n, table.num_columns))
     for i in range(table.num_columns):
         values[:, i] = _column(table, i, allow_missing)
-    if not allow_missing and not np.isfinite(values).all():
-        raise FallBack
     return values, np.arange(fmt.data_line, fmt.data_line + n, dtype=np.int64)
 
 
 def _column(batch: Any, i: int, allow_missing: bool) -> np.ndarray:
-    """Column ``i`` of a record batch as float64; :class:`FallBack` on a null or NaN/inf."""
+    """Column ``i`` of a record batch as float64 (an empty cell: NaN with ``allow_missing``).
+
+    :class:`FallBack` on an empty cell without ``allow_missing`` and on any NaN or inf
+    written as text: pyarrow also takes spellings such as ``nan(1)`` that the number
+    syntax of every clpc reader (:func:`clpc.io.errors.parse_number`) refuses, so the plain
+    reader judges those cells.
+    """
     col = batch.column(i)
-    if col.null_count:
-        if not allow_missing:
-            raise FallBack
-        col = col.fill_null(float("nan"))
-    return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+    nulls = col.null_count
+    if nulls and not allow_missing:
+        raise FallBack
+    values = np.asarray(
+        (col.fill_null(0.0) if nulls else col).to_numpy(zero_copy_only=False), dtype=np.float64
+    )
+    if not np.isfinite(values).all():
+        raise FallBack
+    if nulls:
+        missing = np.asarray(col.is_null().to_numpy(zero_copy_only=False), dtype=bool)
+        values = np.where(missing, np.nan, values)
+    return values
 
 
 def arrow_batches(
@@ -117,8 +129,6 @@ def arrow_batches(
             if n == 0:
                 continue
             values = np.column_stack([_column(batch, i, allow_missing) for i in range(len(use))])
-            if not allow_missing and not np.isfinite(values).all():
-                raise FallBack
             yield values, np.arange(line, line + n, dtype=np.int64)
             line += n
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError, pa.ArrowTypeError):

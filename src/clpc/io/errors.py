@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from clpc.data import DataError
+from clpc.data.samples import NUMBER_TEXT
 
 __all__ = [
     "DataFileNotFoundError",
@@ -21,8 +22,12 @@ __all__ = [
     "check_values",
     "first_bad",
     "is_number",
+    "parse_number",
     "show",
 ]
+
+#: what a numeric cell may hold (the one definition, shared with IOData's text input)
+_NUMBER = NUMBER_TEXT
 
 
 class DataFileNotFoundError(DataError, FileNotFoundError):
@@ -35,12 +40,24 @@ def show(path: str | os.PathLike[str]) -> str:
 
 
 def is_number(text: str) -> bool:
-    """Whether ``float(text)`` succeeds (``"nan"`` and ``"inf"`` count as numbers)."""
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    """Whether ``text`` is a number for every reader (``"nan"`` and ``"inf"`` count)."""
+    return _NUMBER.fullmatch(text.strip()) is not None
+
+
+def parse_number(text: str) -> float:
+    """The value of a numeric cell: ASCII decimal (``1``, ``-2.5e-3``, ``.5``), nan or inf.
+
+    ``float`` alone would also take ``"1_000"``, Arabic-Indic or full-width digits; every
+    reader (files, ``clpc stream``) refuses those the same way.
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not such a number.
+    """
+    if _NUMBER.fullmatch(text.strip()) is None:
+        raise ValueError(f"{text!r} is not a decimal number")
+    return float(text)
 
 
 def cell_error(where: str, column: str, text: str, source: str) -> DataError:

@@ -48,8 +48,13 @@ def _open_source(
     allow_missing: bool,
     skip_rows: int = 0,
     fast: bool = True,
+    whole: bool = False,
 ) -> _Source:
-    """Check the file, resolve the columns and pick the reader of the file's format."""
+    """Check the file, resolve the columns and pick the reader of the file's format.
+
+    ``whole``: every value will be held at once (:func:`read_table`); numpy files larger
+    than the load limit are refused before anything is loaded.
+    """
     p = check_file(path)
     kind = file_kind(p)
     skip = _check_skip_rows(skip_rows)
@@ -60,9 +65,9 @@ def _open_source(
     elif kind == "parquet":
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
-        names, chunks = npy_source(p, columns, allow_missing)
+        names, chunks = npy_source(p, columns, allow_missing, whole)
     else:
-        names, chunks = npz_source(p, columns, allow_missing)
+        names, chunks = npz_source(p, columns, allow_missing, whole)
     return _Source(p, names, chunks)
 
 
@@ -136,7 +141,7 @@ def read_table(
     ImportError
         Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
-    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
     for values, where in src.chunks(_READ_CHUNK):
@@ -180,9 +185,9 @@ def iter_table_chunks(
         Rows per chunk (>= 1). Parquet and ``.npy``/``.npz`` chunks have exactly
         ``chunk_rows`` rows (the last one fewer); a text chunk holds the data rows among
         ``chunk_rows`` consecutive lines (fewer when blank or comment lines occur).
-        Text, Parquet and ``.npy`` files are read piece by piece (``.npy`` memory-mapped);
-        a ``.npz`` file (a zip archive) and the pandas fallback for Parquet are loaded
-        whole and then sliced.
+        Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
+        memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
+        array in Fortran order and the pandas fallback for Parquet are loaded whole.
     columns, delimiter, header, allow_missing, skip_rows, fast
         As for :func:`read_table`.
 

@@ -17,6 +17,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from clpc.appraiser.state_schema import bounded_json
 from clpc.io.errors import DataFileNotFoundError
 from clpc.io.model_schema import (
     FORMAT,
@@ -27,6 +28,11 @@ from clpc.io.model_schema import (
 )
 from clpc.io.model_validation import model_from_dict
 from clpc.model import LinearModel
+
+#: Largest model file read (bytes); a model with its statistics is a few kB.
+MAX_MODEL_BYTES = 64 * 2**20
+#: Deepest JSON nesting read (a model file nests about 5 levels).
+MAX_MODEL_DEPTH = 32
 
 __all__ = [
     "FORMAT",
@@ -69,6 +75,11 @@ def save_model(model: LinearModel, path: str | os.PathLike[str]) -> None:
         The model has non-finite parameters.
     """
     p = Path(os.fspath(path))
+    if p.is_dir():
+        raise ModelFileError(
+            f"cannot save the model to '{p}': it is a directory; pass a file name such as "
+            f"'{p / 'model.json'}'."
+        )
     text = _dumps(model_to_dict(model)) + "\n"
     if not p.parent.is_dir():
         raise DataFileNotFoundError(
@@ -123,16 +134,18 @@ def load_model(path: str | os.PathLike[str]) -> LinearModel:
     if p.is_dir():
         raise ModelFileError(f"'{p}' is a directory, not a model file; pass a .json file.")
     try:
-        text = p.read_text(encoding="utf-8")
+        with p.open(encoding="utf-8") as fh:
+            text = fh.read(MAX_MODEL_BYTES + 1)
     except UnicodeDecodeError:
         raise ModelFileError(
             f"model file '{p}' is not UTF-8 text; it is corrupted or not a clpc model file."
         ) from None
-    try:
-        d = json.loads(text, parse_constant=lambda name: NONFINITE[name])
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(
-            f"model file '{p}' is not valid JSON ({exc.msg} at line {exc.lineno}, column "
-            f"{exc.colno}); the file is corrupted or truncated - save the model again."
-        ) from None
+    d = bounded_json(
+        text,
+        max_bytes=MAX_MODEL_BYTES,
+        max_depth=MAX_MODEL_DEPTH,
+        error=ModelFileError,
+        what=f"model file '{p}'",
+        constants=NONFINITE,
+    )
     return model_from_dict(d, source=str(p))

@@ -140,7 +140,7 @@ def model_to_dict(model: LinearModel) -> dict[str, Any]:
         "dt": dt,
         "input_names": [str(n) for n in model.input_names],
         "output_names": [str(n) for n in model.output_names],
-        "theta": _finite_list(model.theta, "theta"),
+        "theta": _finite_list(model.theta_matrix, "theta"),
         "c": _finite_list(model.c, "c"),
         "den": den,
         "num": num,

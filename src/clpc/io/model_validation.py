@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.state_schema import LongNumber
 from clpc.io.model_schema import FORMAT, NONFINITE, SCHEMA_VERSION, ModelFileError
 from clpc.model import LinearModel, ModelError
 from clpc.model.structure import Structure
@@ -18,6 +19,8 @@ from clpc.model.structure import Structure
 __all__ = ["model_from_dict"]
 
 _MODES = ("siso", "paired", "miso")
+#: largest parameter magnitude read: norms and products of larger values overflow
+_MAX_VALUE = 1e150
 
 
 def _fail(where: str, msg: str) -> ModelFileError:
@@ -47,6 +50,12 @@ def _array_field(value: Any, name: str, shape: tuple[int, ...], where: str) -> n
         raise _fail(where, f"{name} must have shape {shape}; got {arr.shape}.")
     if not np.all(np.isfinite(arr)):
         raise _fail(where, f"{name} must hold finite numbers; got {arr.tolist()}.")
+    if arr.size and np.abs(arr).max() > _MAX_VALUE:
+        raise _fail(
+            where,
+            f"{name} holds {np.abs(arr).max():.3g}; values beyond {_MAX_VALUE:.0e} overflow "
+            "double precision when the model is used (the file was edited or damaged).",
+        )
     return arr
 
 
@@ -59,13 +68,15 @@ def _names_field(value: Any, name: str, n: int, where: str) -> tuple[str, ...]:
 
 
 def _dt_field(dt: Any, where: str) -> float:
-    if (
-        isinstance(dt, bool)
-        or not isinstance(dt, (int, float))
-        or not (math.isfinite(dt) and dt > 0)
-    ):
-        raise _fail(where, f"dt must be a positive number of seconds; got {dt!r}.")
-    return float(dt)
+    value = math.nan
+    if not isinstance(dt, bool) and isinstance(dt, (int, float)):
+        try:
+            value = float(dt)
+        except OverflowError:  # an int no float holds
+            pass
+    if not (math.isfinite(value) and value > 0):
+        raise _fail(where, f"dt must be a positive number of seconds; got {dt!r:.60}.")
+    return value
 
 
 def _info_from_json(value: Any) -> Any:
@@ -74,6 +85,8 @@ def _info_from_json(value: Any) -> Any:
         return {k: _info_from_json(v) for k, v in value.items()}
     if isinstance(value, str):
         return NONFINITE.get(value, value)
+    if isinstance(value, LongNumber) or (isinstance(value, int) and abs(value) > 2**63):
+        raise ValueError(f"a number out of range: {value!r:.60}")
     if isinstance(value, list):
         items = [_info_from_json(v) for v in value]
         try:
@@ -179,6 +192,12 @@ def model_from_dict(d: dict[str, Any], *, source: str | None = None) -> LinearMo
     info = d.get("info", {})
     if not isinstance(info, dict):
         raise _fail(where, f"info must be an object; got {type(info).__name__}.")
+    try:
+        info = _info_from_json(info)
+    except RecursionError:
+        raise _fail(where, "info is nested too deeply; it is not one clpc wrote.") from None
+    except ValueError as exc:
+        raise _fail(where, f"info holds {exc}; it is not one clpc wrote.") from None
     model = LinearModel(
         theta=theta,
         structure=structure,
@@ -188,7 +207,7 @@ def model_from_dict(d: dict[str, Any], *, source: str | None = None) -> LinearMo
         dt=dt,
         input_names=input_names,
         output_names=output_names,
-        info=_info_from_json(info),
+        info=info,
     )
     _check_transfer(model, d, where)
     return model

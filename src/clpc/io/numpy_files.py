@@ -19,6 +19,7 @@ import numpy as np
 
 from clpc.data import DataError
 from clpc.io.errors import check_values, show
+from clpc.io.npz_members import Member, check_load, load_member, member_rows, npz_members
 from clpc.io.table import Chunks, Columns, resolve_columns
 
 __all__ = ["npy_source", "npz_source", "write_npy", "write_npz"]
@@ -103,7 +104,9 @@ def _plain_block(arr: np.ndarray, source: str) -> tuple[list[str], _Block]:
     return [f"col{i}" for i in range(view.shape[1])], block
 
 
-def npy_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[str], Chunks]:
+def npy_source(
+    path: Path, columns: Columns, allow_missing: bool, whole: bool = False
+) -> tuple[list[str], Chunks]:
     """Names of the selected columns of a ``.npy`` file and a chunk generator over them.
 
     Parameters
@@ -112,6 +115,9 @@ def npy_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[
         An existing ``.npy`` file (read memory-mapped).
     columns, allow_missing
         As for :func:`clpc.io.read_table`.
+    whole : bool
+        The caller will hold every selected value at once: refuse more than
+        :func:`clpc.io.npz_members.max_load_bytes` up front.
 
     Returns
     -------
@@ -135,51 +141,45 @@ def npy_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[
         all_names, block = _structured_block(arr, source)
     else:
         all_names, block = _plain_block(arr, source)
+    if whole:
+        n_sel = len(resolve_columns(all_names, columns, source))
+        check_load(int(arr.shape[0]) * n_sel, source, "the selected columns")
     return _array_source(source, all_names, int(arr.shape[0]), block, columns, allow_missing)
 
 
-def _npz_arrays(
-    path: Path, source: str
-) -> tuple[list[str] | None, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """The column names (a string array ``columns``/``names``), 1-D and 2-D arrays."""
+def _npz_layout(path: Path, source: str) -> tuple[list[str] | None, list[Member], list[Member]]:
+    """The column names (a string array ``columns``/``names``), 1-D and 2-D members."""
     _check_magic(path, (b"PK\x03\x04", b"PK\x05\x06"), ".npz", "numpy.savez")
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            arrays = {key: archive[key] for key in archive.files}
-    except ValueError as exc:
-        raise DataError(
-            f"{source} holds arrays that are not plain numeric ({exc}); save numeric arrays "
-            "with numpy.savez."
-        ) from None
-    except (OSError, EOFError, zipfile.BadZipFile) as exc:
-        raise DataError(f"{source} is not a valid .npz file ({exc}).") from None
     names_arr: list[str] | None = None
-    one_d: dict[str, np.ndarray] = {}
-    two_d: dict[str, np.ndarray] = {}
-    for key, value in arrays.items():
-        if value.ndim == 0:
+    one_d: list[Member] = []
+    two_d: list[Member] = []
+    for m in npz_members(path, source):
+        if len(m.shape) == 0:
             continue
-        if key in ("columns", "names") and value.ndim == 1 and value.dtype.kind in "US":
-            names_arr = [str(v) for v in value]
+        if m.key in ("columns", "names") and len(m.shape) == 1 and m.dtype.kind in "US":
+            names_arr = [str(v) for v in load_member(path, m, source)]
             continue
-        if not _numeric_dtype(value.dtype):
+        if not _numeric_dtype(m.dtype):
             raise DataError(
-                f"{source} array {key!r} has dtype {value.dtype}; only real numeric arrays "
+                f"{source} array {m.key!r} has dtype {m.dtype}; only real numeric arrays "
                 "can be read."
             )
-        if value.ndim > 2:
+        if len(m.shape) > 2:
             raise DataError(
-                f"{source} array {key!r} is {value.ndim}-D (shape {value.shape}); expected "
+                f"{source} array {m.key!r} is {len(m.shape)}-D (shape {m.shape}); expected "
                 "1-D columns or one 2-D table."
             )
-        (one_d if value.ndim == 1 else two_d)[key] = value
+        (one_d if len(m.shape) == 1 else two_d).append(m)
     return names_arr, one_d, two_d
 
 
-def npz_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[str], Chunks]:
+def npz_source(
+    path: Path, columns: Columns, allow_missing: bool, whole: bool = False
+) -> tuple[list[str], Chunks]:
     """Names of the selected columns of a ``.npz`` file and a chunk generator over them.
 
-    The archive is loaded whole, then sliced.
+    Only the array headers are read first; the rows are decompressed a chunk at a time
+    (a 2-D array stored in Fortran order is loaded whole, within the load limit).
 
     Parameters
     ----------
@@ -187,6 +187,9 @@ def npz_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[
         An existing ``.npz`` file.
     columns, allow_missing
         As for :func:`clpc.io.read_table`.
+    whole : bool
+        The caller will hold every selected value at once (:func:`clpc.io.read_table`):
+        refuse more than :func:`clpc.io.npz_members.max_load_bytes` up front.
 
     Returns
     -------
@@ -196,38 +199,71 @@ def npz_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[
         ``chunks(chunk_rows)`` yields float64 values (lines None).
     """
     source = show(path)
-    names_arr, one_d, two_d = _npz_arrays(path, source)
+    names_arr, one_d, two_d = _npz_layout(path, source)
     if two_d and (one_d or len(two_d) > 1):
         raise DataError(
-            f"{source} mixes arrays {list(two_d) + list(one_d)}; a .npz table is either one "
-            "2-D array or 1-D arrays of equal length (one per column)."
+            f"{source} mixes arrays {[m.key for m in two_d + one_d]}; a .npz table is either "
+            "one 2-D array or 1-D arrays of equal length (one per column)."
         )
     if two_d:
-        table = next(iter(two_d.values()))
-        n_cols = table.shape[1]
+        n_rows, n_cols = two_d[0].shape
         all_names = (
             names_arr
             if names_arr is not None and len(names_arr) == n_cols
             else [f"col{i}" for i in range(n_cols)]
         )
     elif one_d:
-        lengths = {key: value.shape[0] for key, value in one_d.items()}
-        first = next(iter(lengths))
-        for key, n in lengths.items():
-            if n != lengths[first]:
+        first = one_d[0]
+        for m in one_d:
+            if m.shape[0] != first.shape[0]:
                 raise DataError(
-                    f"{source} columns differ in length: {key!r} has {n} rows but {first!r} "
-                    f"has {lengths[first]}; save columns of equal length."
+                    f"{source} columns differ in length: {m.key!r} has {m.shape[0]} rows but "
+                    f"{first.key!r} has {first.shape[0]}; save columns of equal length."
                 )
-        all_names = list(one_d)
-        table = np.column_stack([one_d[k] for k in all_names])
+        all_names = [m.key for m in one_d]
+        n_rows = first.shape[0]
     else:
         raise DataError(f"data file {source} is empty (no arrays); it needs at least one row.")
+    sel = resolve_columns(all_names, columns, source)
+    if whole:
+        check_load(n_rows * len(sel), source, "the selected columns")
+    if n_rows == 0:
+        raise DataError(f"data file {source} is empty (0 rows); it needs at least one row.")
+    names = [all_names[i] for i in sel]
 
-    def block(start: int, stop: int, idx: list[int]) -> np.ndarray:
-        return np.asarray(table[start:stop, idx], dtype=np.float64)
+    def chunks(chunk_rows: int) -> Iterator[tuple[np.ndarray, None]]:
+        start = 0
+        for values in _npz_blocks(path, source, one_d, two_d, sel, chunk_rows):
+            check_values(values, start, names, source, allow_missing)
+            start += values.shape[0]
+            yield values, None
 
-    return _array_source(source, all_names, int(table.shape[0]), block, columns, allow_missing)
+    return names, chunks
+
+
+def _npz_blocks(
+    path: Path,
+    source: str,
+    one_d: list[Member],
+    two_d: list[Member],
+    sel: list[int],
+    chunk_rows: int,
+) -> Iterator[np.ndarray]:
+    """float64 blocks (rows, len(sel)) of the selected columns."""
+    if two_d and two_d[0].fortran:
+        table = load_member(path, two_d[0], source)
+        for start in range(0, table.shape[0], chunk_rows):
+            yield np.asarray(table[start : start + chunk_rows, sel], dtype=np.float64)
+        return
+    if two_d:
+        for (block,) in member_rows(path, two_d, chunk_rows, source):
+            yield np.asarray(block[:, sel], dtype=np.float64)
+        return
+    use = sorted(set(sel))
+    members = [one_d[i] for i in use]
+    take = [use.index(i) for i in sel]
+    for blocks in member_rows(path, members, chunk_rows, source):
+        yield np.column_stack([blocks[k] for k in take]).astype(np.float64)
 
 
 def write_npy(path: Path, arr: np.ndarray) -> None:

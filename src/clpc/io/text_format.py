@@ -16,6 +16,7 @@ from __future__ import annotations
 import csv
 import gzip
 import re
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
@@ -24,10 +25,12 @@ from clpc.data import DataError
 from clpc.io.errors import is_number, show
 
 __all__ = [
+    "READ_ERRORS",
     "TextFormat",
     "decode_error",
     "is_content",
     "open_text",
+    "read_error",
     "sniff",
     "split_fields",
 ]
@@ -106,6 +109,25 @@ def decode_error(path: Path, exc: UnicodeDecodeError) -> DataError:
     )
 
 
+#: what reading a text file can raise besides OSError: bad UTF-8, a truncated or corrupt gzip
+READ_ERRORS = (UnicodeDecodeError, EOFError, gzip.BadGzipFile, zlib.error)
+
+
+def read_error(path: Path, exc: Exception) -> DataError:
+    """The one-line error naming ``path`` for an exception of :data:`READ_ERRORS`."""
+    if isinstance(exc, UnicodeDecodeError):
+        return decode_error(path, exc)
+    if isinstance(exc, EOFError):
+        return DataError(
+            f"{show(path)} ends in the middle of its gzip stream (the file is truncated: "
+            "an interrupted download or copy?); copy it again or decompress what is there."
+        )
+    return DataError(
+        f"{show(path)} is not a valid gzip file ({exc}); a name ending in .gz must hold "
+        "gzip-compressed text: rename it without .gz if it is plain text."
+    )
+
+
 def _detect_delimiter(lines: list[str]) -> str | None:
     for subset in (lines, lines[1:]):
         if not subset:
@@ -161,8 +183,8 @@ def _first_lines(path: Path, skip_rows: int = 0) -> tuple[list[str], list[tuple[
                     comments.append(line)
                 if content and no > content[0][0] + 8 * _SNIFF_LINES:
                     break
-        except UnicodeDecodeError as exc:
-            raise decode_error(path, exc) from None
+        except READ_ERRORS as exc:
+            raise read_error(path, exc) from None
     if not content:
         what = "only comment lines" if comments else "no lines with data"
         raise DataError(f"data file {show(path)} is empty ({what}); it needs at least one row.")

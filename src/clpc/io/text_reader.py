@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import math
 import operator
+import shutil
+import stat
+import tempfile
 import warnings
 from collections.abc import Iterator
 from itertools import islice, repeat
@@ -17,13 +20,14 @@ import numpy as np
 
 from clpc.data import DataError
 from clpc.io.arrow_text import FallBack, arrow_batches, fast_path_applies
-from clpc.io.errors import cell_error, first_bad, show
+from clpc.io.errors import cell_error, first_bad, parse_number, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 from clpc.io.text_format import (
+    READ_ERRORS,
     TextFormat,
-    decode_error,
     is_content,
     open_text,
+    read_error,
     sniff,
     split_fields,
 )
@@ -100,8 +104,8 @@ class TextReader:
                     line_no += len(lines)
                     if data.shape[0]:
                         yield data, rows
-            except UnicodeDecodeError as exc:
-                raise decode_error(self.path, exc) from None
+            except READ_ERRORS as exc:
+                raise read_error(self.path, exc) from None
 
     def parse(self, lines: list[str], first_no: int) -> tuple[np.ndarray, np.ndarray]:
         """Values (n, len(use)) and 1-based line numbers (n,) of a batch of lines."""
@@ -189,7 +193,7 @@ class TextReader:
     def _cell(self, text: str, no: int, c: int) -> float:
         """The value of field ``text`` in column ``c`` of line ``no`` (empty: NaN)."""
         try:
-            value = float(text) if text else math.nan
+            value = parse_number(text) if text else math.nan
         except ValueError:
             raise cell_error(f"line {no}", self.fmt.names[c], text, self.source) from None
         if not self.allow_missing and not math.isfinite(value):
@@ -236,11 +240,35 @@ def text_source(
     chunks : Chunks
         ``chunks(chunk_rows)`` yields values and the 1-based line number of each row.
     """
+    spool, given = None, path
+    if not stat.S_ISREG(path.stat().st_mode):
+        spool, path = _spool(path)
     fmt = sniff(path, delimiter, header, skip_rows)
-    sel = resolve_columns(fmt.names, columns, show(path))
+    sel = resolve_columns(fmt.names, columns, show(given))
     use = sorted(set(sel))
     reader = TextReader(path, fmt, use, allow_missing, fast)
-    return [fmt.names[i] for i in sel], reorder_columns(reader.batches, use, sel)
+    reader.source = show(given)
+    batches = reader.batches
+    if spool is not None:
+
+        def batches(chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+            with spool:  # removed once read
+                yield from reader.batches(chunk_rows)
+
+    return [fmt.names[i] for i in sel], reorder_columns(batches, use, sel)
+
+
+def _spool(path: Path) -> tuple[tempfile.TemporaryDirectory[str], Path]:
+    """A named pipe or device copied to a temporary file, read once (nothing lost).
+
+    The layout is sniffed from the first lines and the data read from the start again:
+    a stream cannot be read twice, so it is copied to disk first (not into memory).
+    """
+    folder = tempfile.TemporaryDirectory(prefix="clpc-")
+    copy = Path(folder.name) / path.name
+    with open(path, "rb") as src, open(copy, "wb") as dst:
+        shutil.copyfileobj(src, dst, 1 << 20)
+    return folder, copy
 
 
 def rechunk(

@@ -8,14 +8,16 @@ put side by side.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from scipy import signal
 
 from clpc.data import as_iodata
+from clpc.lpc import assessment
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from clpc.lpc.uncertainty import least_squares_covariance, monic_map, with_covariance
 from clpc.model import LinearModel
 
 __all__ = ["ARX", "simulate_arx"]
@@ -29,6 +31,13 @@ class ARX:
     ----------
     order, na, nb, nk, mimo
         As for :class:`clpc.LPC` (same structure, same lag matrices).
+    uncertainty : bool
+        Store the classical covariance ``s^2 (Phi^T Phi)^-1`` (default ``True``;
+        :func:`clpc.lpc.uncertainty.least_squares_covariance`). Valid when the noise is
+        white and enters the equation (``A y = B u + e``); with noise on the output only or
+        on the input the estimate is biased and the intervals do not cover.
+    assess : bool
+        Store the held-out fit and residual tests (default ``True``; as :class:`clpc.LPC`).
     """
 
     order: int = 2
@@ -36,6 +45,8 @@ class ARX:
     nb: int | None = None
     nk: int = 0
     mimo: MimoMode | None = None
+    uncertainty: bool = True
+    assess: bool = True
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
@@ -53,14 +64,21 @@ class ARX:
         mats = regressors(data, structure, mode)
         mean = mats.mean(axis=1)
         thetas = np.empty((mats.shape[0], mats.shape[2]))
+        covs, dofs = [], []
         for j, (m, z) in enumerate(zip(mats, mean, strict=False)):
             centered = m - z
             # y(n) = -[a1..; b..] . rest  ->  theta = [1, x]
             x, *_ = np.linalg.lstsq(centered[:, 1:], -centered[:, 0], rcond=None)
             thetas[j] = np.concatenate([[1.0], x])
+            if self.uncertainty:
+                resid = -centered[:, 0] - centered[:, 1:] @ x
+                cov_x, dof = least_squares_covariance(centered[:, 1:], resid)
+                lmap = monic_map(structure, data.n_inputs, mode, j)
+                covs.append(lmap @ cov_x @ lmap.T)
+                dofs.append(dof)
         thetas /= np.linalg.norm(thetas, axis=1, keepdims=True)
         c = np.einsum("kp,kp->k", mean, thetas)
-        return LinearModel(
+        model = LinearModel(
             theta=thetas,
             structure=structure,
             n_inputs=data.n_inputs,
@@ -71,6 +89,11 @@ class ARX:
             output_names=data.output_names,
             info={"method": "least-squares"},
         )
+        if self.uncertainty:
+            model = with_covariance(model, np.stack(covs), np.array(dofs), "least squares")
+        if not self.assess:
+            return model
+        return assessment.assess(model, data, replace(self, assess=False, uncertainty=False).fit)
 
 
 def simulate_arx(den: Any, num: Any, u: Any, noise: Any | None = None) -> np.ndarray:

@@ -11,7 +11,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -19,10 +19,19 @@ import numpy as np
 from clpc.core import rules
 from clpc.core.checks import resolve_order
 from clpc.data import DataError, IOData, as_iodata
+from clpc.data.samples import check_spread
+from clpc.lpc import assessment
 from clpc.lpc.reduction import reduce_model
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
 from clpc.lpc.solve import RobustRule, SolveResult, noise_covariance, solve_scatter
-from clpc.model import LinearModel
+from clpc.lpc.uncertainty import (
+    jackknife_blocks,
+    lpc_jackknife,
+    monic_map,
+    with_covariance,
+    without_covariance,
+)
+from clpc.model import LinearModel, ModelError
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "structure_blocks"]
 
@@ -172,6 +181,14 @@ class LPC:
         system's, TLS puts the extra common factor near the unit circle. The model then
         has the reduced structure and ``info["cancelled"]`` counts the removed factors
         (:mod:`clpc.lpc.reduction`).
+    uncertainty : bool
+        Store the parameter covariance of a block jackknife over the record
+        (:func:`clpc.lpc.uncertainty.lpc_jackknife`; default ``True``): then
+        :meth:`LinearModel.confidence_interval` and :meth:`LinearModel.summary` work.
+    assess : bool
+        Store the evidence the verdict cites (default ``True``;
+        :func:`clpc.lpc.assessment.assess`): the fit of a refit on the first two thirds
+        scored on the last third, and the residual tests.
     parameters_size : int, optional
         The paper's name for ``order + 1`` (an alias of ``order``; an ``order`` other than
         the default given with it must agree).
@@ -192,6 +209,8 @@ class LPC:
     noise_cov: Any = None
     rule: RobustRule | None = None
     cancel: bool = True
+    uncertainty: bool = True
+    assess: bool = True
     parameters_size: int | None = None
 
     def structure(self) -> Structure:
@@ -224,6 +243,8 @@ class LPC:
             Invalid data, too few samples, or a record in which nothing varies.
         """
         data = as_iodata(u, y, dt)
+        if self.noise_cov is None and self.noise_ratio is None:
+            check_spread(data.u, data.y, self.scaling)
         structure = self.structure()
         mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
         check_mode(mode, data.n_inputs, data.n_outputs)
@@ -258,7 +279,46 @@ class LPC:
             output_names=data.output_names,
             info=info,
         )
-        return reduce_model(model, data) if self.cancel else model
+        model = reduce_model(model, data) if self.cancel else model
+        model = self._with_covariance(model, data, rule) if self.uncertainty else model
+        if not self.assess:
+            return model
+        return assessment.assess(model, data, replace(self, assess=False, uncertainty=False).fit)
+
+    def _with_covariance(self, model: LinearModel, data: IOData, rule: RobustRule) -> LinearModel:
+        """``model`` with the block-jackknife covariance of this solve (at its structure)."""
+        s, mode = model.structure, model.mode
+        n_blocks_in = data.n_inputs if mode == "miso" else 1
+        mats = regressors(data, s, mode)  # type: ignore[arg-type]
+        groups = jackknife_blocks(mats.shape[1], mats.shape[2])
+        if not groups:
+            return without_covariance(model, f"{mats.shape[1]} lag vectors are too few to split")
+        try:
+            noise_cov = noise_covariance(self.noise_cov, self.noise_ratio, s, n_blocks_in)
+        except ValueError:
+            return without_covariance(model, "the noise covariance does not fit the reduced order")
+
+        def solve(scatter: np.ndarray, mean: np.ndarray, rows: np.ndarray) -> np.ndarray:
+            return solve_scatter(
+                scatter, mean, rows, n_output_cols=s.na + 1,
+                blocks=structure_blocks(s, n_blocks_in), method=self.method,
+                noise_cov=noise_cov, rule=rule, scaling=self.scaling,
+            ).theta  # fmt: skip
+
+        def to_monic(theta: np.ndarray, j: int) -> np.ndarray:
+            a0 = theta[:, :1]
+            if np.any(np.abs(a0) <= 1e-9 * np.linalg.norm(theta, axis=1, keepdims=True)):
+                raise ModelError("a jackknife replicate has a0 about 0 (no monic form)")
+            return (theta[:, 1:] / a0) @ monic_map(s, model.n_inputs, mode, j).T
+
+        try:
+            cov = lpc_jackknife(mats, solve, to_monic, groups)
+        except (ModelError, ValueError) as exc:  # no monic replicate; a noise_cov of p entries
+            return without_covariance(model, f"the jackknife could not run: {exc}")
+        how = f"block jackknife over {groups} segments"
+        if model.info.get("cancelled"):
+            how += " (LPC solve at the reduced order)"
+        return with_covariance(model, cov, groups - 1, how)
 
 
 def _raise_if_degenerate(res: SolveResult, data: IOData) -> None:

@@ -24,7 +24,7 @@ import numpy as np
 
 from clpc.core.polynomials import UNIT_CIRCLE_TOL  # a pole this close to the circle is on it
 
-__all__ = ["HeldOutScore", "fit_percent", "horizon", "score", "stability"]
+__all__ = ["HeldOutScore", "fit_percent", "horizon", "output_scores", "score", "stability"]
 
 #: Shortest prediction horizon [samples].
 MIN_HORIZON = 2
@@ -108,3 +108,21 @@ def score(model: Any, data: Any, split: int, k: int) -> HeldOutScore:
     free_run = fit_percent(val.y, sim)
     kstep = fit_percent(val.y[start:], pred[start:])
     return HeldOutScore(free_run, kstep, 0.5 * (free_run + kstep), kind)
+
+
+def output_scores(model: Any, data: Any, split: int, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Free-run and ``k``-step fit % of each output on ``data[split:]``, as :func:`score`.
+
+    Returns
+    -------
+    free_run, kstep : ndarray, shape (n_outputs,)
+        -inf where a prediction diverges.
+    """
+    val = data[split:]
+    with np.errstate(all="ignore"):
+        sim = np.asarray(model.simulate(data.u)).reshape(data.y.shape)[split:]
+        pred = np.asarray(model.predict(val.u, val.y, k=k)).reshape(val.y.shape)
+    start = model.structure.max_lag + k
+    free = [fit_percent(val.y[:, j], sim[:, j]) for j in range(val.y.shape[1])]
+    ahead = [fit_percent(val.y[start:, j], pred[start:, j]) for j in range(val.y.shape[1])]
+    return np.array(free), np.array(ahead)

@@ -18,6 +18,12 @@ from clpc.lpc.estimator import LPC
 __all__ = ["DelaySelection", "OrderSelection", "select_delay", "select_order"]
 
 
+def candidate_settings(estimator: Any) -> Any:
+    """The estimator without covariance and assessment: candidates only need their fit."""
+    quick = {k: False for k in ("uncertainty", "assess") if hasattr(estimator, k)}
+    return replace(estimator, **quick)
+
+
 @dataclass(frozen=True)
 class OrderSelection:
     """Table of criteria per order and the chosen order.
@@ -134,7 +140,7 @@ def select_order(
     if orders.size == 0 or orders[0] < 1:
         raise ValueError(f"orders must be ints >= 1; got {orders.tolist()}.")
     data = as_iodata(u, y, dt)
-    base = estimator or LPC()
+    base = candidate_settings(estimator or LPC())
     largest = replace(base, order=int(orders[-1]), na=None, nb=None).structure().max_lag
     rows = []
     for order in orders:
@@ -143,8 +149,8 @@ def select_order(
         skip = largest - est.structure().max_lag  # drop samples so all use the same rows
         model = est.fit(data[skip:])
         info = model.info
-        n = int(info["n_rows"][0])
-        n_free = (model.theta.shape[1] - 1 + 2) * model.n_outputs
+        n = int(np.atleast_1d(info["n_rows"])[0])
+        n_free = (model.theta_matrix.shape[1] - 1 + 2) * model.n_outputs
         loglik = float(np.sum(info["log_likelihood"]))
         rows.append(
             (
@@ -263,7 +269,7 @@ def select_delay(
     if not 0.0 < validation_fraction < 1.0:
         raise ValueError(f"validation_fraction must be in (0, 1); got {validation_fraction!r}.")
     data = as_iodata(u, y, dt)
-    base = estimator or LPC()
+    base = candidate_settings(estimator or LPC())
     split = round(data.n_samples * (1.0 - validation_fraction))
     est, val = data[:split], data[split:]
     fits = []

@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from clpc.core.polynomials import monic, pole_class, pole_words
-from clpc.model import simulation
+from clpc.core.polynomials import monic, pole_class
+from clpc.model import display, simulation
+from clpc.model import uncertainty as _unc
 from clpc.model.errors import ModelError
 from clpc.model.structure import Structure
 
@@ -40,8 +41,10 @@ class LinearModel:
 
     Parameters
     ----------
-    theta : ndarray, shape (n_outputs, p)
-        Unit-norm parameter vectors, one per output (paper convention).
+    theta : ndarray, shape (p,) for one output, else (n_outputs, p)
+        Unit-norm parameter vectors, one per output (paper convention). A single-output
+        model keeps ``theta`` 1-D (and its per-output ``info`` statistics scalar); the
+        2-D form of every model is :attr:`theta_matrix`.
     structure : Structure
         Orders and delay.
     n_inputs : int
@@ -70,14 +73,22 @@ class LinearModel:
 
     def __post_init__(self) -> None:
         theta = np.atleast_2d(np.asarray(self.theta, dtype=np.float64))
-        object.__setattr__(self, "theta", theta)
+        object.__setattr__(self, "_theta2", theta)
+        object.__setattr__(self, "theta", theta[0] if theta.shape[0] == 1 else theta)
         object.__setattr__(self, "c", np.atleast_1d(np.asarray(self.c, dtype=np.float64)))
+        if theta.shape[0] == 1:
+            object.__setattr__(self, "info", display.squeeze_info(self.info))
+
+    @property
+    def theta_matrix(self) -> np.ndarray:
+        """``theta`` of every output as rows: shape (n_outputs, p), also for one output."""
+        return self._theta2  # type: ignore[attr-defined]
 
     # ----------------------------------------------------------------- conventions
     @property
     def n_outputs(self) -> int:
         """Number of outputs (equations)."""
-        return int(self.theta.shape[0])
+        return int(self.theta_matrix.shape[0])
 
     @property
     def is_siso(self) -> bool:
@@ -85,12 +96,13 @@ class LinearModel:
         return self.n_outputs == 1 and self.n_inputs == 1
 
     def _a0(self) -> np.ndarray:
-        a0 = self.theta[:, 0]
-        scale = np.linalg.norm(self.theta, axis=1)
+        theta = self.theta_matrix
+        a0 = theta[:, 0]
+        scale = np.linalg.norm(theta, axis=1)
         if np.any(np.abs(a0) <= 1e-12 * np.maximum(scale, 1e-300)):
             j = int(np.argmin(np.abs(a0)))
             raise ModelError(
-                f"a0 of output {j} is about 0 (theta={self.theta[j].round(6).tolist()}): the "
+                f"a0 of output {j} is about 0 (theta={theta[j].round(6).tolist()}): the "
                 "data do not determine y(n), so the monic transfer function does not exist. "
                 "Check the excitation or lower the order."
             )
@@ -104,7 +116,7 @@ class LinearModel:
         num = np.empty((self.n_outputs, self.n_inputs, s.nk + s.nb + 1))
         for j in range(self.n_outputs):
             pair = j if self.mode == "paired" else -1
-            monic(np.asarray(self.theta[j], float), s.na, s.nb, s.nk, pair, den[j], num[j])
+            monic(self.theta_matrix[j], s.na, s.nb, s.nk, pair, den[j], num[j])
         return den, num
 
     @property
@@ -214,6 +226,34 @@ class LinearModel:
 
         return fit_verdict(self, output)
 
+    # ------------------------------------------- uncertainty (clpc.model.uncertainty)
+    @property
+    def covariance(self) -> np.ndarray:
+        """Covariance of ``np.r_[den[1:], num]`` per output, shape (n_outputs, q, q)."""
+        return _unc.covariance(self)
+
+    def confidence_interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
+        """``(lo, hi)`` ordered like ``np.r_[den[1:], num]`` (rows per output if several)."""
+        return _unc.confidence_interval(self, level)
+
+    def pole_std(self, output: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Poles and the std of their real and imaginary parts, shape (na, 2)."""
+        return _unc.pole_std(self, output)
+
+    def dc_gain_std(self) -> np.ndarray:
+        """Standard deviation of :meth:`dc_gain`, shape (n_outputs, n_inputs)."""
+        return _unc.dc_gain_std(self)
+
+    def frequency_response_std(
+        self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(freqs_hz, response, std of |G|, std of arg G [rad])`` (delta method)."""
+        return _unc.frequency_response_std(self, freqs, output, input)
+
+    def summary(self) -> str:
+        """Coefficients with +- one standard deviation, poles and DC gains, as text."""
+        return _unc.summary(self)
+
     # ----------------------------------------------------------------- time domain
     def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
         """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
@@ -311,10 +351,29 @@ class LinearModel:
         num = np.trim_zeros(num, "f") if np.any(num) else num[-1:]
         return signal.dlti(num, den, dt=self.dt)
 
-    def to_control(self) -> Any:
-        """Export as a python-control ``TransferFunction`` (MIMO when needed).
+    def to_control(self, *, include_offset: bool = True) -> Any:
+        """Export as a python-control ``StateSpace`` system with the channel names.
 
-        Needs the optional dependency ``control`` (``pip install clpc[control]``).
+        Each output equation is realised in observer canonical form (its inputs share the
+        denominator ``A_j``; ``n = max(na, nk + nb)`` states), the outputs stacked block by
+        block. A state-space system simulates without slycot (a MIMO transfer function
+        does not); ``control.ss2tf`` gives the transfer function of a SISO export.
+
+        Parameters
+        ----------
+        include_offset : bool
+            Add an input named ``"offset"`` (last) through which the constant
+            ``intercept_j`` enters output ``j`` as ``intercept_j / A_j(z)``. Driven with
+            ones, ``control.forced_response`` equals :meth:`simulate` (zero initial
+            conditions, offset included). ``False`` exports the deviation model (the
+            ``n_inputs`` inputs only, like ``simulate(..., include_offset=False)``).
+
+        Returns
+        -------
+        control.StateSpace
+            Inputs named after :attr:`input_names` (and ``"offset"``), outputs after
+            :attr:`output_names`, ``dt`` the sample time [s]. Needs the optional
+            dependency ``control`` (``pip install clpc[control]``).
         """
         try:
             import control
@@ -322,28 +381,30 @@ class LinearModel:
             raise ImportError(
                 "to_control() needs python-control: pip install 'clpc[control]'"
             ) from None
-        nums = [
-            [list(self._padded(j, i)[0]) for i in range(self.n_inputs)]
-            for j in range(self.n_outputs)
-        ]
-        dens = [
-            [list(self._padded(j, i)[1]) for i in range(self.n_inputs)]
-            for j in range(self.n_outputs)
-        ]
-        if self.is_siso:
-            return control.TransferFunction(nums[0][0], dens[0][0], self.dt)
-        return control.TransferFunction(nums, dens, self.dt)
-
-    def _stability_words(self) -> str:
-        try:
-            return pole_words(self.stability)
-        except (ValueError, np.linalg.LinAlgError):  # no poles (a0 = 0)
-            return "no poles"
+        blocks = []
+        for j in range(self.n_outputs):
+            pairs = [self._padded(j, i) for i in range(self.n_inputs)]
+            if include_offset:
+                den = pairs[0][1]
+                pairs.append((np.r_[self.intercept[j], np.zeros(den.size - 1)], den))
+            blocks.append(simulation.observer_form([p[0] for p in pairs], pairs[0][1]))
+        n_in = self.n_inputs + int(include_offset)
+        sizes = [blk[0].shape[0] for blk in blocks]
+        a = np.zeros((sum(sizes), sum(sizes)))
+        b = np.zeros((sum(sizes), n_in))
+        c = np.zeros((self.n_outputs, sum(sizes)))
+        d = np.zeros((self.n_outputs, n_in))
+        at = 0
+        for j, (aj, bj, cj, dj) in enumerate(blocks):
+            sl = slice(at, at + sizes[j])
+            a[sl, sl], b[sl], c[j, sl], d[j] = aj, bj, cj, dj
+            at += sizes[j]
+        inputs = [*self.input_names, *(["offset"] if include_offset else [])]
+        return control.ss(a, b, c, d, self.dt, inputs=inputs, outputs=list(self.output_names))
 
     def __repr__(self) -> str:
-        s = self.structure
-        return (
-            f"LinearModel(na={s.na}, nb={s.nb}, nk={s.nk}, inputs={self.n_inputs}, "
-            f"outputs={self.n_outputs}, mode={self.mode!r}, dt={self.dt:g}, "
-            f"{self._stability_words()})"
-        )
+        return display.model_repr(self)
+
+    def _repr_html_(self) -> str:
+        """The model as an HTML table (Jupyter)."""
+        return display.model_html(self)

@@ -134,3 +134,36 @@ def infer_input(
 
 
 # ----------------------------------------------------------------- export
+def observer_form(
+    nums: list[np.ndarray], den: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Observer canonical state-space form of ``y = sum_i nums[i](z) / den(z) u_i``.
+
+    Parameters
+    ----------
+    nums : list of ndarray, each shape (n + 1,)
+        Numerators, ascending powers of ``z^-1`` (padded to the denominator's length).
+    den : ndarray, shape (n + 1,)
+        Monic denominator (``den[0] = 1``), ascending powers of ``z^-1``.
+
+    Returns
+    -------
+    a : ndarray, shape (n, n)
+    b : ndarray, shape (n, n_inputs)
+    c : ndarray, shape (n,)
+    d : ndarray, shape (n_inputs,)
+        ``x(n+1) = a x(n) + b u(n)``, ``y(n) = c x(n) + d u(n)``; from a zero state its
+        response equals ``lfilter(nums[i], den, u_i)`` summed over the inputs.
+    """
+    den = np.asarray(den, dtype=np.float64)
+    n = den.size - 1
+    num = np.array(nums, dtype=np.float64).reshape(len(nums), n + 1)
+    a = np.zeros((n, n))
+    a[:, 0] = -den[1:]
+    a[: n - 1, 1:] = np.eye(n - 1)
+    d = num[:, 0]
+    b = (num[:, 1:] - np.outer(d, den[1:])).T
+    c = np.zeros(n)
+    if n:
+        c[0] = 1.0
+    return a, b, c, d

@@ -5,6 +5,13 @@ near-null subspace the solution was taken from (``n_null``), the near-null relat
 involve almost no output (``n_input_relations``: the input alone satisfies them, so it is not
 persistently exciting of the model's order), the separation of the solution's eigenvalue from
 the next one, and the stability of the monic model.
+
+A fit's verdict opens with the evidence that the model describes the record, when the
+estimator stored it (:mod:`clpc.lpc.assessment`): the held-out free-run and ``k``-step fit
+and the residual tests. The model is *adequate* when the held-out free-run fit is at least
+:data:`clpc.core.rules.MIN_HELDOUT_FIT` % and the residuals are independent of the input;
+"the data determine the parameters" speaks of identifiability only and never stands alone
+beside a model that is not adequate.
 """
 
 from __future__ import annotations
@@ -15,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from clpc.core.polynomials import pole_class, pole_words
+from clpc.core.rules import MIN_HELDOUT_FIT
 
 __all__ = ["Verdict", "describe_trace", "fit_verdict"]
 
@@ -40,6 +48,13 @@ class Verdict:
     stability : str
         ``"stable"``, ``"integrating"`` (a pole at z = 1: an integrator, not a failure),
         ``"marginal"`` or ``"unstable"`` (:func:`clpc.core.polynomials.pole_class`).
+    heldout_fit, heldout_kstep : float or None
+        Held-out free-run and ``k``-step fit % (``None``: not assessed).
+    residuals_independent, residuals_white : bool or None
+        Outcome of the residual tests of this output (``None``: not assessed).
+    adequate : bool or None
+        Held-out free-run fit at least :data:`~clpc.core.rules.MIN_HELDOUT_FIT` % and
+        residuals independent of the input (``None``: not assessed).
     """
 
     n_null: int
@@ -49,22 +64,102 @@ class Verdict:
     order: int
     messages: tuple[str, ...]
     stability: str = "stable"
+    heldout_fit: float | None = None
+    heldout_kstep: float | None = None
+    residuals_independent: bool | None = None
+    residuals_white: bool | None = None
+    adequate: bool | None = None
 
     def __str__(self) -> str:
         return "; ".join(self.messages)
 
 
+def _fmt(fit: float) -> str:
+    if not np.isfinite(fit):
+        return "diverges"
+    return f"{fit:.1f} %" if abs(fit) < 1e4 else f"{fit:.2g} %"
+
+
+def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, Any]]:
+    """Words and numbers of the stored held-out fit and residual tests of one output."""
+    msgs: list[str] = []
+    found: dict[str, Any] = {}
+    held = info.get("heldout")
+    if isinstance(held, dict) and "free_run" in held:
+        fr, ks = float(held["free_run"]), float(held["kstep"])
+        if "free_run_outputs" in held:  # this output's own fits
+            fr = float(np.atleast_1d(held["free_run_outputs"])[output])
+            ks = float(np.atleast_1d(held["kstep_outputs"])[output])
+        found["heldout_fit"], found["heldout_kstep"] = fr, ks
+        poor = not fr >= MIN_HELDOUT_FIT
+        msgs.append(
+            f"held-out fit (refit on the first {int(held['split'])} samples, scored on the last "
+            f"{int(held['n_heldout'])}): free run {_fmt(fr)}, {int(held['horizon'])}-step "
+            f"prediction {_fmt(ks)}"
+            + (
+                f" - below {MIN_HELDOUT_FIT:g} %: the model describes the record poorly"
+                if poor
+                else ""
+            )
+        )
+    test = info.get("residual_test")
+    if isinstance(test, dict) and "white" in test:
+        white = bool(np.atleast_1d(test["white"])[output])
+        indep = np.atleast_2d(test["independent"])[output]
+        zeta = np.atleast_2d(test["independence_zeta"])[output]
+        z_thr = np.atleast_2d(test["independence_threshold"])[output]
+        q, q_thr = (np.atleast_1d(test[k])[output] for k in ("whiteness_Q", "whiteness_threshold"))
+        found["residuals_independent"], found["residuals_white"] = bool(np.all(indep)), white
+        worst = int(np.argmax(zeta / z_thr))
+        if np.all(indep):
+            msgs.append(
+                f"residuals independent of the input (zeta = {zeta[worst]:.3g} <= "
+                f"{z_thr[worst]:.3g})"
+            )
+        else:
+            msgs.append(
+                f"residuals correlated with the input (zeta = {zeta[worst]:.3g} > "
+                f"{z_thr[worst]:.3g}): the model misses part of the input's effect - try "
+                "another order or input delay (nk)"
+            )
+        msgs.append(
+            f"residuals white (Q = {q:.3g} <= {q_thr:.3g})"
+            if white
+            else f"residuals not white (Q = {q:.3g} > {q_thr:.3g}): colored noise or "
+            "dynamics the model misses"
+        )
+    if "heldout_fit" in found and "residuals_independent" in found:
+        ok = found["heldout_fit"] >= MIN_HELDOUT_FIT and found["residuals_independent"]
+        found["adequate"] = bool(ok)
+        if ok:
+            head = "the model describes the record"
+        elif found["heldout_fit"] >= MIN_HELDOUT_FIT:
+            head = "the model fits held-out data, but its residuals still carry the input"
+        else:
+            head = "the model does NOT describe the record well"
+        msgs.insert(0, head)
+    return msgs, found
+
+
 def fit_verdict(model: Any, output: int = 0) -> Verdict:
-    """The verdict of an LPC fit (:meth:`clpc.LPC.fit`) for one output."""
+    """The verdict of a fit (:meth:`clpc.LPC.fit`, :meth:`clpc.ARX.fit`) for one output."""
     info = model.info
-    stable, kind, words = _stability(model, output)
-    if "n_null" not in info:  # e.g. a CLPC steady-state model: no single fit behind it
-        notes = ("no fit statistics (an averaged or loaded model)", f"the model is {words}")
-        return Verdict(0, True, False, stable, model.structure.nb + 1, notes, kind)
-    n_null = int(np.asarray(info["n_null"])[output])
-    n_input = int(np.asarray(info["n_input_relations"])[output])
-    determined = bool(np.asarray(info["determined"])[output])
-    sep = float(np.asarray(info["separation"])[output])
+    words, found = evidence(info, output)
+    stable, kind, said = _stability(model, output)
+    if "n_null" not in info:  # e.g. least squares, or a CLPC steady-state model
+        what = "no eigenvalue statistics" if words else "no fit statistics"
+        notes = (
+            *words,
+            f"{what} (a least-squares, averaged or loaded model)",
+            f"the model is {said}",
+        )
+        return Verdict(
+            0, True, False, stable, model.structure.nb + 1, notes, stability=kind, **found
+        )
+    n_null = int(np.atleast_1d(info["n_null"])[output])
+    n_input = int(np.atleast_1d(info["n_input_relations"])[output])
+    determined = bool(np.atleast_1d(info["determined"])[output])
+    sep = float(np.atleast_1d(info["separation"])[output])
     order = model.structure.nb + 1
     msgs = []
     if n_input:
@@ -88,14 +183,17 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             "than the system's (common pole-zero factors); consider a lower order"
         )
     if determined:
-        msgs.append(f"the data determine the parameters (eigenvalue separation {sep:.2g})")
+        but = " - identifiability only, not a good fit" if found.get("adequate") is False else ""
+        msgs.append(f"the data determine the parameters (eigenvalue separation {sep:.2g}){but}")
     elif not n_input and n_null == 1:
         msgs.append(
             f"the parameters are poorly determined (smallest eigenvalue {sep:.2g} of the next):"
             " the data hardly prefer this model to others"
         )
-    msgs.append(f"the model is {words}")
-    return Verdict(n_null, n_input == 0, determined, stable, order, tuple(msgs), kind)
+    msgs.append(f"the model is {said}")
+    return Verdict(
+        n_null, n_input == 0, determined, stable, order, (*words, *msgs), stability=kind, **found
+    )
 
 
 def _stability(model: Any, output: int) -> tuple[bool, str, str]:

@@ -7,10 +7,19 @@
   :mod:`clpc.plants.servo_records`, its compiled inner loop :mod:`clpc.plants.servo_loop`;
 * :mod:`clpc.plants.commands` - position commands (the paper's Fig. 5 ramp with
   saturation, steps, trapezoidal moves) on the sample grid of :mod:`clpc.plants.grid`;
-* :mod:`clpc.plants.excitation` - excitation signals (chirp, PRBS, multisine).
+* :mod:`clpc.plants.excitation` - excitation signals (chirp, PRBS, multisine);
+* :mod:`clpc.plants.crank_servo` - a servo lifting a load through a crank: gravity and
+  inertia that change with the position (issue 18), with its integrator negative control.
 """
 
 from clpc.plants.commands import ramp_with_saturation, steps, trapezoid_moves
+from clpc.plants.crank_servo import (
+    CrankParameters,
+    CrankRecord,
+    crank_commands,
+    crank_operating_point,
+    simulate_crank_servo,
+)
 from clpc.plants.excitation import chirp, multisine, prbs
 from clpc.plants.grid import time_grid
 from clpc.plants.servo import (
@@ -23,14 +32,19 @@ from clpc.plants.servo import (
 )
 
 __all__ = [
+    "CrankParameters",
+    "CrankRecord",
     "MotorRecord",
     "ServoParameters",
     "ServoRecord",
     "chirp",
+    "crank_commands",
+    "crank_operating_point",
     "multisine",
     "numba_available",
     "prbs",
     "ramp_with_saturation",
+    "simulate_crank_servo",
     "simulate_motor_open_loop",
     "simulate_servo",
     "steps",

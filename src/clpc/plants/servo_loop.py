@@ -6,7 +6,11 @@ as plain Python (``engine="python"``, :data:`_servo_loop_py`) or compiled by num
 :func:`clpc.core.jit.compiled` (``_servo_loop_jit``, built on first use).
 
 Sample ``i`` is logged at the start of the controller period that begins at ``t_i``: the
-resolver reading the drive uses, the true states and the commands computed then.
+resolver reading the drive uses, the true states and the velocity command computed then.
+The torque of sample ``i`` is the mean of the controller's torque over the logging period
+that starts at ``t_i`` (the torque the mechanics integrate over it): one controller sample
+per period would alias the loop's noise-driven torque, which the motor averages and the
+position never shows, into the log.
 """
 
 from __future__ import annotations
@@ -30,7 +34,14 @@ from clpc.plants.servo_kernels import (
     _quantise,
     _store_state,
 )
-from clpc.plants.servo_layout import _P_LOADFB, _P_OPEN, _P_RES, LoopConfig, LoopInputs
+from clpc.plants.servo_layout import (
+    _O_TAU,
+    _P_LOADFB,
+    _P_OPEN,
+    _P_RES,
+    LoopConfig,
+    LoopInputs,
+)
 
 __all__ = ["numba_available"]
 
@@ -70,6 +81,7 @@ def _servo_loop(config: LoopConfig, inputs: LoopInputs, state: np.ndarray, out: 
     k = 0  # controller step within the chunk
     for i in range(command.shape[0]):
         r = command[i]
+        tau_sum = 0.0
         for j in range(config.steps_per_sample):
             th_fb = shaft.th_l if load_fb else shaft.th_m  # resolver: noise, then quantiser
             if has_noise:
@@ -82,12 +94,14 @@ def _servo_loop(config: LoopConfig, inputs: LoopInputs, state: np.ndarray, out: 
                 v_cmd, tau, drive = _drive_step(gains, filt, drive, r, y)
             if j == 0:
                 _log_sample(out, i, y, shaft, v_cmd, tau)
+            tau_sum += tau
             tau_app = tau
             if has_dist:
                 tau_app += disturbance[k]
             for _s in range(config.substeps):
                 shaft = _mechanics_step(mech, shaft, tau_app)
             k += 1
+        out[i, _O_TAU] = tau_sum / config.steps_per_sample  # mean torque of the period
     _store_state(state, shaft, drive)
 
 

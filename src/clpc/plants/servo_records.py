@@ -72,7 +72,9 @@ class ServoRecord:
         Output of the position loop [rad/s].
     torque_command : numpy.ndarray
         Logged torque command [N m]: the controller output after the filters and the
-        current limit, plus ``torque_noise_std`` logging noise, if any.
+        current limit, averaged over the logging period that starts at ``time`` (what
+        the motor integrates; one controller sample would alias the loop's noise), plus
+        ``torque_noise_std`` logging noise, if any.
     true_torque_command : numpy.ndarray
         Torque command without logging noise [N m] (without the disturbance too).
     sample_time : float

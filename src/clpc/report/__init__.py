@@ -7,7 +7,9 @@ them from here.
 
 from clpc.appraiser.tracefile import trace_columns
 from clpc.core.jsonable import jsonable
+from clpc.report.comparison import Comparison, compare
 from clpc.report.html import Section, write_html_report
+from clpc.report.identify import write_identify_report
 from clpc.report.summaries import (
     model_response,
     model_summary,
@@ -20,7 +22,9 @@ from clpc.report.text import format_fit, format_model_summary
 from clpc.report.track import write_track_report
 
 __all__ = [
+    "Comparison",
     "Section",
+    "compare",
     "format_fit",
     "format_model_summary",
     "jsonable",
@@ -32,5 +36,6 @@ __all__ = [
     "update_records",
     "verdict_text",
     "write_html_report",
+    "write_identify_report",
     "write_track_report",
 ]

@@ -1,4 +1,9 @@
-"""A self-contained HTML report: titled sections of text, tables and PNG figures."""
+"""A self-contained HTML report: titled sections of text, warnings, tables and PNG figures.
+
+The page is valid HTML5 with a viewport meta (readable on a phone), numbers that never wrap
+inside (``1.2e-06`` stays on one line), warnings in a visible box and sections that can be
+collapsed (``<details>``, e.g. the settings at the end).
+"""
 
 from __future__ import annotations
 
@@ -14,6 +19,9 @@ import numpy as np
 
 __all__ = ["Section", "write_html_report"]
 
+#: an image: its file, or its file and a caption
+Image = str | PathLike[str] | tuple[str | PathLike[str], str]
+
 
 @dataclass
 class Section:
@@ -26,58 +34,111 @@ class Section:
         Paragraph text (escaped; blank lines separate paragraphs).
     table : mapping or sequence of rows, optional
         A mapping ``{name: value}`` (two-column table) or rows whose first row is the header.
-    images : sequence of path-like
+    images : sequence of path-like or (path-like, caption)
         PNG files to show (embedded as base64, or linked relative to the report).
     preformatted : str, optional
         Text shown verbatim (e.g. a printed model).
+    warnings : sequence of str
+        Shown first, in a highlighted box.
+    collapsed : bool
+        Show the section folded (``<details>``); the reader opens it.
+    html : str, optional
+        Trusted HTML inserted as is after the text (e.g. a model's ``_repr_html_``).
     """
 
     heading: str
     text: str | None = None
     table: Mapping[str, Any] | Sequence[Sequence[Any]] | None = None
-    images: Sequence[str | PathLike[str]] = field(default_factory=list)
+    images: Sequence[Image] = field(default_factory=list)
     preformatted: str | None = None
+    warnings: Sequence[str] = ()
+    collapsed: bool = False
+    html: str | None = None
 
 
 _CSS = (
-    "body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}"
-    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;"
-    "padding:.25em .6em;text-align:right}th{background:#f3f3f3}td:first-child{text-align:left}"
-    "img{max-width:100%;border:1px solid #eee}pre{background:#f8f8f8;padding:.8em;"
-    "overflow-x:auto}"
+    "body{font-family:system-ui,sans-serif;max-width:62em;margin:1.5em auto;padding:0 1em;"
+    "color:#222;line-height:1.45}"
+    "h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ddd}"
+    "table{border-collapse:collapse;margin:.8em 0;font-size:.92em;display:block;"
+    "overflow-x:auto;max-width:100%}"
+    "td,th{border:1px solid #ccc;padding:.25em .6em;text-align:left;vertical-align:top}"
+    "th{background:#f3f3f3}td.num{text-align:right;white-space:nowrap;"
+    "font-variant-numeric:tabular-nums}caption{text-align:left;font-weight:600}"
+    "figure{margin:1em 0}figcaption{font-size:.9em;color:#555}"
+    "img{max-width:100%;height:auto;border:1px solid #eee}"
+    "pre{background:#f8f8f8;padding:.8em;overflow-x:auto;font-size:.88em}"
+    ".warn{border:2px solid #d9822b;background:#fff4e5;padding:.5em 1em;margin:.8em 0;"
+    "border-radius:4px}.warn ul{margin:.3em 0;padding-left:1.2em}"
+    ".ok{border:2px solid #3c9a5f;background:#edf8f0;padding:.5em 1em;margin:.8em 0;"
+    "border-radius:4px}"
+    "details>summary{cursor:pointer;font-size:1.5em;font-weight:bold;margin-top:1.2em}"
 )
 
 
-def _cell(v: Any) -> str:
-    if isinstance(v, (float, np.floating)):
-        return html.escape(f"{float(v):.6g}")
-    return html.escape(str(v))
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(
+        v, (bool, np.bool_)
+    )
+
+
+def _cell(v: Any, tag: str = "td") -> str:
+    if _is_number(v):
+        text = f"{float(v):.6g}" if isinstance(v, (float, np.floating)) else str(v)
+        return f'<{tag} class="num">{html.escape(text)}</{tag}>'
+    if v is None:
+        return f"<{tag}>&ndash;</{tag}>"
+    return f"<{tag}>{html.escape(str(v))}</{tag}>"
 
 
 def _table_html(table: Mapping[str, Any] | Sequence[Sequence[Any]]) -> str:
     if isinstance(table, Mapping):
-        rows = [f"<tr><td>{_cell(k)}</td><td>{_cell(v)}</td></tr>" for k, v in table.items()]
+        rows = [f"<tr>{_cell(k, 'th')}{_cell(v)}</tr>" for k, v in table.items()]
         return "<table>" + "".join(rows) + "</table>"
     rows_in = [list(r) for r in table]
     if not rows_in:
         return ""
-    head = "".join(f"<th>{_cell(c)}</th>" for c in rows_in[0])
-    body = "".join(
-        "<tr>" + "".join(f"<td>{_cell(c)}</td>" for c in row) + "</tr>" for row in rows_in[1:]
-    )
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in rows_in[0])
+    body = "".join("<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in rows_in[1:])
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def _image_html(img: Path, report_dir: Path, embed: bool) -> str:
-    alt = html.escape(img.stem)
+def _image_html(image: Image, report_dir: Path, embed: bool) -> str:
+    path, caption = image if isinstance(image, tuple) else (image, None)
+    img = Path(path)
+    alt = html.escape(caption or img.stem.replace("_", " "))
     if embed:
         data = base64.b64encode(img.read_bytes()).decode("ascii")
-        return f'<p><img alt="{alt}" src="data:image/png;base64,{data}"></p>'
-    try:
-        rel = img.resolve().relative_to(report_dir.resolve()).as_posix()
-    except ValueError:
-        rel = img.resolve().as_uri()
-    return f'<p><img alt="{alt}" src="{html.escape(rel)}"></p>'
+        src = f"data:image/png;base64,{data}"
+    else:
+        try:
+            src = img.resolve().relative_to(report_dir.resolve()).as_posix()
+        except ValueError:
+            src = img.resolve().as_uri()
+    cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
+    return f'<figure><img alt="{alt}" src="{html.escape(src)}">{cap}</figure>'
+
+
+def _section_html(sec: Section, report_dir: Path, embed: bool) -> str:
+    parts = []
+    if sec.warnings:
+        items = "".join(f"<li>{html.escape(w)}</li>" for w in sec.warnings)
+        parts.append(
+            f'<div class="warn" role="note"><strong>Warnings</strong><ul>{items}</ul></div>'
+        )
+    if sec.text:
+        parts += [f"<p>{html.escape(p.strip())}</p>" for p in sec.text.split("\n\n") if p.strip()]
+    if sec.html:
+        parts.append(sec.html)
+    if sec.preformatted:
+        parts.append(f"<pre>{html.escape(sec.preformatted)}</pre>")
+    if sec.table is not None:
+        parts.append(_table_html(sec.table))
+    parts += [_image_html(img, report_dir, embed) for img in sec.images]
+    heading = html.escape(sec.heading)
+    if sec.collapsed:
+        return f"<details><summary>{heading}</summary>{''.join(parts)}</details>"
+    return f"<section><h2>{heading}</h2>{''.join(parts)}</section>"
 
 
 def write_html_report(
@@ -111,19 +172,13 @@ def write_html_report(
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body><main>",
         f"<h1>{html.escape(title)}</h1>",
     ]
     for sec in sections:
         sec = sec if isinstance(sec, Section) else Section(**sec)
-        parts.append(f"<h2>{html.escape(sec.heading)}</h2>")
-        if sec.text:
-            parts += [f"<p>{html.escape(p.strip())}</p>" for p in sec.text.split("\n\n")]
-        if sec.preformatted:
-            parts.append(f"<pre>{html.escape(sec.preformatted)}</pre>")
-        if sec.table is not None:
-            parts.append(_table_html(sec.table))
-        parts += [_image_html(Path(img), out.parent, embed_images) for img in sec.images]
-    parts.append("</body></html>")
+        parts.append(_section_html(sec, out.parent, embed_images))
+    parts.append("</main></body></html>")
     out.write_text("\n".join(parts), encoding="utf-8")
     return out

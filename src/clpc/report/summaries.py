@@ -20,7 +20,9 @@ from clpc.appraiser.trace import SCALAR_KEYS, Trace
 from clpc.core.jsonable import jsonable
 from clpc.core.polynomials import pole_class
 from clpc.data import IOData
-from clpc.model import LinearModel
+from clpc.model import LinearModel, ModelError
+from clpc.model.residuals import residual_analysis
+from clpc.model.uncertainty import parameter_labels, parameter_std, parameter_vector
 from clpc.model.verdict import describe_trace, fit_verdict
 
 __all__ = [
@@ -37,10 +39,12 @@ def verdict_text(model: LinearModel, output: int = 0) -> str | None:
     """The identifiability verdict of one output equation in plain words.
 
     Uses :func:`clpc.verdict.fit_verdict` on the statistics in ``model.info``
-    (``determined``, ``n_null``, ``n_input_relations``...); ``None`` for models without
-    them (e.g. a CLPC steady-state model or a hand-built one).
+    (``determined``, ``n_null``, ``n_input_relations``...) and the evidence a fit stored
+    (``heldout``, ``residual_test``); ``None`` for models with neither (e.g. a CLPC
+    steady-state model or a hand-built one).
     """
-    if not all(k in model.info for k in ("n_null", "n_input_relations", "determined")):
+    has_eig = all(k in model.info for k in ("n_null", "n_input_relations", "determined"))
+    if not has_eig and "heldout" not in model.info:
         return None
     return str(fit_verdict(model, output))
 
@@ -126,6 +130,11 @@ def model_summary(
     def stat(key: str, j: int) -> Any:
         return jsonable(np.atleast_1d(info[key])[j]) if key in info else None
 
+    try:
+        sigma: np.ndarray | None = np.atleast_2d(parameter_std(model))
+    except ModelError:
+        sigma = None
+    labels, values = parameter_labels(model), parameter_vector(model)
     equations = []
     for j in range(model.n_outputs):
         poles = model.poles(j)
@@ -145,6 +154,19 @@ def model_summary(
                 "determined": stat("determined", j),
                 "n_input_relations": stat("n_input_relations", j),
                 "verdict": verdict_text(model, j),
+                "parameters": [
+                    {
+                        "name": n,
+                        "value": jsonable(v),
+                        "std": None if sigma is None else jsonable(sd),
+                    }
+                    for n, v, sd in zip(
+                        labels,
+                        values[j],
+                        np.zeros_like(values[j]) if sigma is None else sigma[j],
+                        strict=True,
+                    )
+                ],
             }
         )
     out: dict[str, Any] = {
@@ -167,6 +189,11 @@ def model_summary(
             fits["simulation" if k is None else f"prediction_{k}"] = jsonable(fit)
         out["n_samples"] = data.n_samples
         out["fit"] = fits
+        try:
+            res = residual_analysis(model, data.u, data.y)
+            out["residual_test"] = {"passed": res.passed, "tests": [str(t) for t in res.tests]}
+        except ValueError as exc:
+            out["residual_test"] = {"passed": None, "tests": [f"not computed: {exc}"]}
     return out
 
 

@@ -66,13 +66,28 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
                 f"  [{out}]  D = lambda_max - lambda_min = {eq['D']:.6g}   lambda_min = "
                 f"{eq['lambda_min']:.6g}   lambda_min/lambda_max = {eq['eig_ratio']:.3g}"
             )
+        if eq.get("parameters") and eq["parameters"][0]["std"] is not None:
+            pars = ", ".join(
+                f"{p['name']} {p['value']:.6g} +- {p['std']:.2g}"
+                for p in eq["parameters"]
+                if p["std"] or p["value"]
+            )
+            lines.append(f"  [{out}]  parameters (+- 1 sigma): {pars}")
         if eq["verdict"] is not None:
-            lines.append(f"  [{out}]  identifiability: {eq['verdict']}")
+            lines.append(f"  [{out}]  verdict: {eq['verdict']}")
         if "fit" in summary:
             fits = "   ".join(
                 f"{_fit_label(key)} {format_fit(vals[j])}" for key, vals in summary["fit"].items()
             )
             lines.append(f"  [{out}]  fit: {fits}")
+    if "residual_test" in summary:
+        lines.append(
+            "residual tests (whiteness: Ljung-Box Q; independence from the inputs: zeta) "
+            + {True: "passed", False: "FAILED", None: "not computed"}[
+                summary["residual_test"]["passed"]
+            ]
+        )
+        lines.extend(f"  {t}" for t in summary["residual_test"]["tests"])
     lines.append(f"model is {_stability(summary)}")
     return "\n".join(lines)
 

@@ -1,7 +1,13 @@
-"""The track report: figures and an HTML page of one CLPC trace (``clpc track --report``)."""
+"""The track report: figures and an HTML page of one CLPC trace (``clpc track``).
+
+Read top down: the result (converged or not, the model, warnings in a box), the model's
+fit on the measured data with residuals, its step and Bode responses, the trace, and last,
+folded, the latest updates and the settings.
+"""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
@@ -9,12 +15,65 @@ from typing import Any
 
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
-from clpc.plotting import plot_bode, plot_pz, plot_trace
+from clpc.plotting import plot_trace
 from clpc.report.html import Section, write_html_report
-from clpc.report.summaries import model_summary, steady_state, trace_summary
-from clpc.report.text import format_model_summary
+from clpc.report.parts import model_sections, model_warnings, settings_section
+from clpc.report.summaries import steady_state, trace_summary
 
-__all__ = ["write_track_report"]
+__all__ = ["trace_warnings", "write_track_report"]
+
+#: a count finding of :func:`clpc.describe_trace`, e.g. "1 of 249 clusters determine ..."
+_COUNT = re.compile(r"^(\d+) of (\d+) clusters ")
+
+
+def trace_warnings(trace: Trace, summary: Mapping[str, Any]) -> list[str]:
+    """What a reader must not miss about a trace: no convergence, flagged clusters.
+
+    Parameters
+    ----------
+    trace : Trace
+    summary : mapping
+        :func:`trace_summary` of ``trace``.
+
+    Returns
+    -------
+    list of str
+        The findings of :func:`clpc.describe_trace` that report a problem (a cluster count
+        is one when not every cluster qualifies) and, when the trace did not converge, why.
+    """
+    out = []
+    conv = summary["convergence"]
+    if not conv["converged"] and summary["model_source"] == "none":
+        out.append("no update was accepted: there is no model")
+    elif not conv["converged"]:
+        out.append(
+            "the trace did not converge: the model shown is the "
+            f"{summary['model_source']}, not a steady state"
+        )
+    for finding in summary["findings"]:
+        counted = _COUNT.match(finding)
+        if counted and counted.group(1) == counted.group(2):
+            continue  # "249 of 249 clusters ...": all fine
+        out.append(finding)
+    return out
+
+
+def _result_table(trace: Trace, summary: Mapping[str, Any]) -> dict[str, Any]:
+    conv = summary["convergence"]
+    unit = "s" if trace.sample_time != 1.0 else "samples"
+    table: dict[str, Any] = {
+        "inputs → outputs": f"{', '.join(trace.input_names)} → {', '.join(trace.output_names)}",
+        "cluster updates": summary["updates"],
+        "accepted": summary["accepted"],
+        "determined by their window": summary["determined"],
+        "too few rows": summary["not_enough_data"],
+        "converged": "yes" if conv["converged"] else "no",
+    }
+    if conv["converged"]:
+        table[f"converged at time [{unit}]"] = conv["time"]
+        table["converged at sample"] = conv["index"]
+    table["model"] = summary["model_source"]
+    return table
 
 
 def write_track_report(
@@ -24,22 +83,39 @@ def write_track_report(
     title: str = "CLPC report",
     settings: Mapping[str, Any] | None = None,
     summary: Mapping[str, Any] | None = None,
+    data: Any = None,
+    data_note: str = "",
+    data_t0: float = 0.0,
+    steady: tuple[Any, str] | None = None,
+    recent: Trace | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
     Parameters
     ----------
     out_dir : str or path-like
-        Folder (created) for ``trace.png``, ``pz.png`` and ``bode.png`` (of the
-        :func:`steady_state` model, when there is one) and ``report.html``.
+        Folder (created) for ``trace.png``, the figures of the :func:`steady_state` model
+        (when there is one: ``step.png``, ``bode.png``, ``pz.png`` and, with ``data``,
+        ``fit.png`` and ``data.png``) and ``report.html``.
     trace : Trace
         The appraiser's output.
     title : str
         Report title.
     settings : mapping, optional
-        Settings shown as a table (e.g. :meth:`clpc.CLPC.config` and the file name).
+        Settings shown, folded, at the end (e.g. :meth:`clpc.CLPC.config` and the file).
     summary : mapping, optional
         :func:`trace_summary` of ``trace`` (computed when omitted).
+    data : IOData, optional
+        Measured record (at the trace's sample time) to compare the model with.
+    data_note : str
+        Where ``data`` comes from (e.g. "the last 4000 samples of the record").
+    data_t0 : float
+        Time of ``data``'s first sample in the record (the fit figure's time axis).
+    steady : (LinearModel or None, str), optional
+        :func:`steady_state` of the whole record when ``trace`` is a thinned copy
+        (computed from ``trace`` when omitted).
+    recent : Trace, optional
+        The last updates, unthinned, for the table of the last 20 (default ``trace``).
 
     Returns
     -------
@@ -48,41 +124,44 @@ def write_track_report(
     """
     out = Path(out_dir)
     summary = trace_summary(trace) if summary is None else summary
-    files = [plot_trace(trace, out / "trace.png", title=title)]
-    table = {"inputs": ", ".join(trace.input_names), "outputs": ", ".join(trace.output_names)}
-    table.update({k: v for k, v in (settings or {}).items() if not isinstance(v, Mapping)})
-    conv = summary["convergence"]
-    counts = {k: summary[k] for k in ("updates", "accepted", "determined", "not_enough_data")}
-    counts["converged"] = conv["converged"]
-    if conv["converged"]:
-        counts["converged at time [s]"] = conv["time"]
-        counts["converged at sample"] = conv["index"]
-    sections = [
-        Section("Settings", table=table),
-        Section("Summary", table=counts, text="\n\n".join(summary["findings"])),
+    model, source = steady_state(trace) if steady is None else steady
+    warnings = trace_warnings(trace, summary)
+    if model is not None:
+        warnings += model_warnings(model)
+    findings = [f for f in summary["findings"] if f not in warnings]
+    result = Section(
+        "Result",
+        warnings=warnings,
+        text="\n\n".join(findings) if findings else None,
+        table=_result_table(trace, summary),
+    )
+    sections = [result]
+    files: list[Path] = []
+    if model is not None:
+        more, files = model_sections(model, out, data=data, data_note=data_note, data_t0=data_t0)
+        more[0].heading = f"Model: {source}"
+        sections += more
+    else:
+        result.text = "The figure of the trace below shows why no estimate was accepted."
+    trace_png = out / "trace.png"
+    plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
+    files.append(trace_png)
+    sections.append(
         Section(
             "Trace",
-            text="Degree of linearity D and parameter vector theta (paper convention, unit "
-            "norm) per cluster update; red crosses: estimate not accepted (the last accepted "
-            "one is held); orange circles: not determined by the window.",
-            images=files[:1],
-        ),
-    ]
-    model, source = steady_state(trace)
-    if model is not None:
-        files += [plot_pz(model, out / "pz.png"), plot_bode(model, out / "bode.png")]
-        sections.append(
-            Section(
-                f"Model ({source})",
-                preformatted=format_model_summary(model_summary(model)),
-                images=files[-2:],
-            )
+            text="Degree of linearity D and each entry of the parameter vector theta (paper "
+            "convention, unit norm) per cluster update, each on its own scale. Marked on D: "
+            "updates not accepted (the last accepted estimate is held), not determined by "
+            "the window, or with too few rows. Long traces are drawn as min/max envelopes.",
+            images=[(trace_png, "the trace")],
         )
-    names, values = trace_columns(trace)
+    )
+    names, values = trace_columns(trace if recent is None else recent)
     wanted = {"index", "time", "D", "accepted", "determined", *trace.labels()}
     keep = [i for i, n in enumerate(names) if n.split(":")[-1] in wanted]
     rows: list[list[Any]] = [[names[i] for i in keep]]
     rows += [[row[i] for i in keep] for row in values[-20:]]
-    sections.append(Section(f"Last {len(rows) - 1} updates", table=rows))
+    sections.append(Section(f"Last {len(rows) - 1} updates", table=rows, collapsed=True))
+    sections.append(settings_section(settings or {}))
     files.append(write_html_report(out / "report.html", title, sections))
     return files

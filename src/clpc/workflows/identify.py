@@ -11,7 +11,8 @@ import numpy as np
 from clpc.core.checks import check_choice, check_int
 from clpc.core.jsonable import jsonable
 from clpc.io import save_model
-from clpc.lpc import LPC, OrderSelection, select_order
+from clpc.lpc import LPC, Identification, OrderSelection, identify, select_order
+from clpc.lpc.selection import ESTIMATORS
 from clpc.model import LinearModel, MimoMode
 from clpc.report import model_summary
 from clpc.workflows.common import METHODS, Method, RecordSpec, SettingsError
@@ -37,10 +38,10 @@ class IdentifySettings:
         Largest order tried by ``order="auto"``.
     criterion : {"validation", "bic", "aic", "remark1"}
         How ``order="auto"`` chooses.
-    nk : int
-        Input delay in samples.
+    nk : int or "auto"
+        Input delay in samples, or ``"auto"`` (0..4, :func:`clpc.identify`).
     method : {"robust", "paper"}
-        LPC solution.
+        LPC solution (without ``estimator`` only).
     mimo : {"miso", "paired"}, optional
         Multi-channel structure.
     save : str, optional
@@ -48,31 +49,60 @@ class IdentifySettings:
     na, nb : int, optional
         Separate output / input orders overriding ``order`` (clpc's meaning: ``nb + 1``
         coefficients per input; MATLAB's ``arx`` nb is clpc's ``nb + 1``).
+    estimator : {"auto", "lpc", "arx", "oe"}, optional
+        Compare LPC, least squares and output error on held-out data (:func:`clpc.identify`)
+        and keep this one (``"auto"``: the best). ``None`` (default): LPC alone, as before,
+        unless ``nk="auto"`` (then ``"lpc"`` with the comparison).
     """
 
     record: RecordSpec
     order: int | Literal["auto"] = 2
     max_order: int = 6
     criterion: Criterion = "validation"
-    nk: int = 0
+    nk: int | Literal["auto"] = 0
     method: Method = "robust"
     mimo: MimoMode | None = None
     save: str | None = None
     na: int | None = None
     nb: int | None = None
+    estimator: str | None = None
 
     def __post_init__(self) -> None:
         if self.order != "auto":
             check_int(self.order, "order", 1)
         check_int(self.max_order, "max_order", 1)
         check_choice(self.criterion, "criterion", CRITERIA)
-        check_int(self.nk, "nk", 0)
+        if self.nk != "auto":
+            check_int(self.nk, "nk", 0)
         check_choice(self.method, "method", METHODS)
         for name in ("na", "nb"):
             if getattr(self, name) is not None:
                 check_int(getattr(self, name), name, 0 if name == "nb" else 1)
         if self.order == "auto" and (self.na is not None or self.nb is not None):
             raise SettingsError("order auto chooses na = nb = N; do not also give na or nb.")
+        if self.estimator is not None:
+            check_choice(self.estimator, "estimator", ESTIMATORS)
+        if self.compares:
+            if self.na is not None or self.nb is not None:
+                raise SettingsError(
+                    "na/nb apply to LPC alone; the estimator comparison (estimator or "
+                    "nk='auto') fits na = nb = N. Give --order instead, or drop the comparison."
+                )
+            if self.method != "robust":
+                raise ValueError(
+                    f"method={self.method!r} applies to LPC alone; the estimator comparison "
+                    "(estimator or nk='auto') uses the default LPC. Drop one of the two."
+                )
+            if self.order == "auto" and self.criterion != "validation":
+                raise ValueError(
+                    f"criterion={self.criterion!r}: the estimator comparison chooses the order "
+                    "on held-out data only (criterion 'validation')."
+                )
+
+    @property
+    def compares(self) -> bool:
+        """Whether :func:`identify_file` runs :func:`clpc.identify` (the comparison)."""
+        return self.estimator is not None or self.nk == "auto"
 
 
 @dataclass(frozen=True)
@@ -90,12 +120,15 @@ class IdentifyResult:
         The order selection table (``order="auto"`` only).
     criterion : str
         The criterion that chose the order.
+    comparison : Identification or None
+        The estimator comparison (:func:`clpc.identify`), when the settings ask for it.
     """
 
     model: LinearModel
     summary: dict[str, Any]
     selection: OrderSelection | None
     criterion: Criterion
+    comparison: Identification | None = None
 
     def scores(self) -> np.ndarray:
         """The criterion's value per order of :attr:`selection`.
@@ -138,6 +171,9 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
         Unreadable record; data that do not determine a model.
     """
     data = settings.record.load()
+    if settings.compares:
+        return _compare(settings, data)
+    assert settings.nk != "auto"
     estimator = LPC(
         nk=settings.nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
     )
@@ -170,3 +206,32 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
         save_model(model, settings.save)
         summary["saved"] = settings.save
     return IdentifyResult(model, summary, selection, settings.criterion)
+
+
+def _compare(settings: IdentifySettings, data: Any) -> IdentifyResult:
+    """:func:`identify_file` with the estimator comparison (:func:`clpc.identify`)."""
+    found = identify(
+        data,
+        estimator=settings.estimator or "lpc",
+        order=settings.order,
+        nk=settings.nk,
+        max_order=settings.max_order,
+        mimo=settings.mimo,
+    )
+    summary = model_summary(found.model, data)
+    summary["comparison"] = jsonable(
+        {
+            "estimators": list(found.estimators),
+            "order": found.order,
+            "nk": found.nk,
+            "horizon": found.horizon,
+            "table": found.table,
+            "delays": found.delays,
+            "reason": found.reason,
+            "eiv_violated": None if found.eiv is None else found.eiv.violated,
+        }
+    )
+    if settings.save:
+        save_model(found.model, settings.save)
+        summary["saved"] = settings.save
+    return IdentifyResult(found.model, summary, None, settings.criterion, found)

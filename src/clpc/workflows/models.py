@@ -69,6 +69,9 @@ def simulate_file(
     ------
     ChannelCountError
         ``inputs`` does not name one column per model input.
+    clpc.DataError
+        The simulation leaves the range of double precision (an unstable model): nothing
+        is written.
     """
     model = load_model(model_file)
     cols = model_columns(model, inputs, "input")
@@ -76,12 +79,29 @@ def simulate_file(
     table = read_table(file, columns=keys)
     n_in = len(cols)
     u = table.data[:, :n_in]
-    y_sim = np.asarray(model.simulate(u)).reshape(table.n_rows, -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        y_sim = np.asarray(model.simulate(u)).reshape(table.n_rows, -1)
+    _check_bounded(y_sim, model, model_file)
     names = [*table.names[n_in:], *table.names[:n_in], *(f"{n}_sim" for n in model.output_names)]
     values = np.hstack([table.data[:, n_in:], u, y_sim])
     if out:
         write_table(out, names, values)
     return SimulateResult(names, values, out)
+
+
+def _check_bounded(y_sim: np.ndarray, model: Any, model_file: str) -> None:
+    """Refuse a simulation that overflowed (no file of inf/nan is written)."""
+    bad = ~np.isfinite(y_sim)
+    if not bad.any():
+        return
+    row, col = (int(i) for i in np.argwhere(bad)[0])
+    radius = max(float(np.max(np.abs(model.poles(e)), initial=0.0)) for e in range(bad.shape[1]))
+    raise DataError(
+        f"the simulation of {model_file} diverges: output {model.output_names[col]!r} leaves "
+        f"the range of double precision at sample {row} (the model is unstable: a pole of "
+        f"magnitude {radius:.6g} > 1); nothing was written. Simulate fewer samples, or use "
+        "a stable model."
+    )
 
 
 # =============================================================================== compare
@@ -176,7 +196,15 @@ def compare_file(settings: CompareSettings) -> CompareResult:
     record = dataclasses.replace(settings.record, inputs=tuple(ins), outputs=tuple(outs))
     data = record.load()
     _check_sample_time(model.dt, data.dt, record)
-    y_hat, start, fit = model_response(model, data.u, data.y, settings.k)
+    first = model.structure.max_lag + (settings.k or 1) - 1  # first sample scored
+    if settings.k is not None and data.n_samples <= first + 1:
+        raise DataError(
+            f"--k {settings.k}: a {settings.k}-step prediction is scored from sample {first} "
+            f"on (max lag {model.structure.max_lag} + k - 1), but {record.file} has "
+            f"{data.n_samples} samples; use a k below {data.n_samples - model.structure.max_lag}."
+        )
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging fit is reported as NaN
+        y_hat, start, fit = model_response(model, data.u, data.y, settings.k)
     what = "simulation" if settings.k is None else f"{settings.k}-step prediction"
     fits = dict(zip(outs, jsonable(fit), strict=True))
     if settings.plot:

@@ -6,9 +6,7 @@ number detection, not exported), not one sample at a time with per-line error re
 
 from __future__ import annotations
 
-import json
-import math
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -18,7 +16,14 @@ from clpc.appraiser import CLPC
 from clpc.core.checks import check_choice, check_int, check_positive
 from clpc.data import DataError
 from clpc.report import update_records
-from clpc.workflows.common import AppraiserSettings
+from clpc.workflows.common import AppraiserSettings, SamplingConflictError, SettingsError
+from clpc.workflows.stream_lines import (
+    LineReader,
+    SampleClock,
+    Timed,
+    parse_csv_sample,
+    parse_jsonl_sample,
+)
 
 __all__ = [
     "StreamBatch",
@@ -40,13 +45,20 @@ class StreamSettings:
     appraiser : AppraiserSettings
         The appraiser's settings.
     dt : float, optional
-        Sample time of the data [s] (default 1).
+        Sample time of the data [s] (default 1, or from ``time_col``).
     n_in, n_out : int
-        Inputs and outputs per sample.
+        Inputs and outputs per sample (without ``inputs``/``outputs``).
     fmt : {"csv", "jsonl"}
         Lines ``"u1,...,y1,..."`` or ``{"u": ..., "y": ...}``.
     on_error : {"skip", "stop"}
         A malformed line: report it and skip it, or end the stream with ``DataError``.
+    inputs, outputs : tuple of str
+        Columns to use: csv names (from a header line) or 0-based indices written as
+        digits; JSON keys (one number each). Empty: the first ``n_in`` fields are the
+        inputs and the next ``n_out`` the outputs (csv), keys ``"u"``/``"y"`` (JSON).
+    time_col : str, optional
+        Column (csv name or index, JSON key) of sample times [s]: the sample time is the
+        step between the first two samples; a sample off that grid is a malformed line.
     """
 
     appraiser: AppraiserSettings = field(default_factory=AppraiserSettings)
@@ -55,6 +67,9 @@ class StreamSettings:
     n_out: int = 1
     fmt: Literal["csv", "jsonl"] = "csv"
     on_error: Literal["skip", "stop"] = "skip"
+    inputs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    time_col: str | None = None
 
     def __post_init__(self) -> None:
         if self.dt is not None:
@@ -63,6 +78,32 @@ class StreamSettings:
         check_int(self.n_out, "n_out", 1)
         check_choice(self.fmt, "fmt", ("csv", "jsonl"))
         check_choice(self.on_error, "on_error", ("skip", "stop"))
+        if bool(self.inputs) != bool(self.outputs):
+            raise SettingsError(
+                "give both the input and the output columns (--input and --output), or "
+                "neither (then fields are inputs first, outputs next)."
+            )
+        pairs = (("input", self.inputs, self.n_in), ("output", self.outputs, self.n_out))
+        for kind, cols, n in pairs:
+            if cols and n not in (1, len(cols)):
+                raise SettingsError(
+                    f"{len(cols)} {kind} column(s) were named {list(cols)} but "
+                    f"--{kind}s {n} was given; drop --{kind}s."
+                )
+        if self.dt is not None and self.time_col is not None:
+            raise SamplingConflictError()
+        if self.appraiser.decimate_to is not None and self.dt is None and self.time_col is None:
+            raise SettingsError(
+                "--decimate-to is the rate the appraiser works at (the data are decimated to "
+                "it); give the data's own sample time with --dt (or --time) as well."
+            )
+
+    @property
+    def channels(self) -> tuple[int, int]:
+        """Inputs and outputs per sample."""
+        if self.inputs:
+            return len(self.inputs), len(self.outputs)
+        return self.n_in, self.n_out
 
 
 @dataclass(frozen=True)
@@ -75,137 +116,17 @@ class StreamBatch:
         One :func:`clpc.report.update_records` entry per cluster update (JSON-safe).
     skipped : list of str
         One message per malformed line skipped: ``"line N: what: 'text'"``.
+    notes : list of str
+        Lines read as something other than a sample, e.g. ``"line 1: header (column
+        names): u, y"``.
+    samples : int
+        Valid samples in the batch.
     """
 
     records: list[dict[str, Any]] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
-
-
-def _finite(values: list[float]) -> None:
-    for i, v in enumerate(values, 1):
-        if not math.isfinite(v):
-            raise ValueError(f"value {i} is {v}; samples must be finite")
-
-
-def parse_csv_sample(line: str, n_in: int, n_out: int) -> Sample:
-    """One sample from a line ``"u1,...,y1,..."``.
-
-    Parameters
-    ----------
-    line : str
-        The line, without its newline.
-    n_in, n_out : int
-        Inputs and outputs per sample.
-
-    Returns
-    -------
-    u, y : list of float
-        The inputs and the outputs.
-
-    Raises
-    ------
-    ValueError
-        Wrong number of fields, a field that is not a number, a value that is not finite.
-    """
-    fields = [f.strip() for f in line.split(",")]
-    if len(fields) != n_in + n_out:
-        raise ValueError(
-            f"expected {n_in + n_out} comma-separated numbers ({n_in} input(s) then "
-            f"{n_out} output(s)); got {len(fields)} field(s)"
-        )
-    values = []
-    for i, f in enumerate(fields, 1):
-        try:
-            values.append(float(f))
-        except ValueError:
-            raise ValueError(f"field {i} {f!r} is not a number") from None
-    _finite(values)
-    return values[:n_in], values[n_in:]
-
-
-def parse_jsonl_sample(line: str, n_in: int, n_out: int) -> Sample:
-    """One sample from a line ``{"u": ..., "y": ...}`` (a number, or a list per channel).
-
-    Parameters
-    ----------
-    line : str
-        The line, without its newline.
-    n_in, n_out : int
-        Inputs and outputs per sample.
-
-    Returns
-    -------
-    u, y : list of float
-        The inputs and the outputs.
-
-    Raises
-    ------
-    ValueError
-        Not JSON, not such an object, wrong counts or types, values that are not finite.
-    """
-    try:
-        obj = json.loads(line)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"not valid JSON ({exc.msg})") from None
-    except RecursionError:
-        raise ValueError("not a sample: JSON nested too deeply") from None
-    if not isinstance(obj, dict) or "u" not in obj or "y" not in obj:
-        raise ValueError('expected an object {"u": ..., "y": ...}')
-    out = []
-    for key, n in (("u", n_in), ("y", n_out)):
-        val = obj[key]
-        vals = val if isinstance(val, list) else [val]
-        if len(vals) != n or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals
-        ):
-            want = "a number" if n == 1 else f"a list of {n} numbers"
-            raise ValueError(f"{key!r} must be {want}; got {val!r}")
-        try:
-            out.append([float(v) for v in vals])
-        except OverflowError:
-            raise ValueError(f"{key!r} holds a number too large for a float") from None
-    _finite(out[0] + out[1])
-    return out[0], out[1]
-
-
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _is_header(line: str) -> bool:
-    fields = [f.strip() for f in line.split(",")]
-    return all(f and not _is_float(f) for f in fields)
-
-
-class _LineReader:
-    """Samples from numbered lines: skips blanks, comments and a first csv header line."""
-
-    def __init__(self, settings: StreamSettings) -> None:
-        self.n_in, self.n_out = settings.n_in, settings.n_out
-        self.parse: Callable[[str, int, int], Sample] = (
-            parse_csv_sample if settings.fmt == "csv" else parse_jsonl_sample
-        )
-        self.header_possible = settings.fmt == "csv"
-        self.no = 0  # physical line number (1-based)
-
-    def read(self, line: str) -> Sample | None:
-        """The sample of the next line, or None; ``ValueError("line N: ...")`` if malformed."""
-        self.no += 1
-        text = line.strip().lstrip("\ufeff")
-        if not text or text.startswith("#"):
-            return None
-        if self.header_possible and _is_header(text):
-            self.header_possible = False
-            return None
-        self.header_possible = False
-        try:
-            return self.parse(text, self.n_in, self.n_out)
-        except ValueError as exc:
-            raise ValueError(f"line {self.no}: {exc}: {text[:80]!r}") from None
+    notes: list[str] = field(default_factory=list)
+    samples: int = 0
 
 
 def _push(appraiser: CLPC, samples: list[Sample], n_in: int, n_out: int) -> list[dict[str, Any]]:
@@ -217,47 +138,85 @@ def _push(appraiser: CLPC, samples: list[Sample], n_in: int, n_out: int) -> list
     return update_records(trace) if len(trace) else []
 
 
+class _Session:
+    """The appraiser of one stream; built once the data's sample time is known."""
+
+    def __init__(self, settings: StreamSettings) -> None:
+        self.s = settings
+        self.n_in, self.n_out = settings.channels
+        self.clock = SampleClock() if settings.time_col is not None else None
+        self.appraiser: CLPC | None = None
+        self.waiting: list[Sample] = []  # samples before the sample time is known
+
+    def accept(self, sample: Timed) -> None:
+        """Check the sample's time (``ValueError`` when off the grid)."""
+        if self.clock is not None:
+            assert sample[2] is not None
+            self.clock.check(sample[2])
+
+    def push(self, samples: list[Sample]) -> list[dict[str, Any]]:
+        if self.appraiser is None:
+            if self.clock is not None and self.clock.dt is None:
+                self.waiting += samples
+                return []
+            dt = self.clock.dt if self.clock is not None else self.s.dt
+            self.appraiser = self.s.appraiser.build(dt)
+            samples, self.waiting = self.waiting + samples, []
+        return _push(self.appraiser, samples, self.n_in, self.n_out)
+
+
 def stream_samples(
     batches: Iterable[Iterable[str]], settings: StreamSettings
 ) -> Iterator[StreamBatch]:
     """Run the appraiser on lines of samples, one batch of lines at a time.
 
-    Blank lines and lines starting with ``#`` are ignored, and a first csv line of names
-    is a header. The samples of a batch are pushed to the appraiser together.
+    Blank lines and lines starting with ``#`` are ignored. A first csv line of names is the
+    header when it has the stream's field count (or holds the named columns); it is
+    reported in :attr:`StreamBatch.notes`. Any other line that is not a sample (text,
+    numbers no float holds, ``1_5``, non-ASCII digits, deep JSON nesting, wrong types or
+    counts, a time off the grid) is malformed. The samples of a batch are pushed to the
+    appraiser together.
 
     Parameters
     ----------
     batches : iterable of iterables of str
         Lines as they arrive (e.g. what a pipe holds at each read).
     settings : StreamSettings
-        Appraiser, channel counts, line format, what a malformed line does.
+        Appraiser, channels, line format, what a malformed line does.
 
     Yields
     ------
     StreamBatch
-        The updates of each batch and the malformed lines it skipped.
+        The updates of each batch, the malformed lines it skipped and its notes.
 
     Raises
     ------
     clpc.DataError
         A malformed line with ``on_error="stop"`` (after a last batch with the updates of
         the samples before it).
+    SettingsError
+        Named columns that the header does not hold (or no header to find them in).
     """
-    appraiser = settings.appraiser.build(settings.dt)
-    reader = _LineReader(settings)
-    n_in, n_out = settings.n_in, settings.n_out
+    session = _Session(settings)
+    reader = LineReader(settings)
     for batch in batches:
         samples: list[Sample] = []
         skipped: list[str] = []
         for line in batch:
             try:
                 sample = reader.read(line)
+                if sample is not None:
+                    session.accept(sample)
             except ValueError as exc:
+                if isinstance(exc, SettingsError):
+                    raise
                 if settings.on_error == "stop":
-                    yield StreamBatch(_push(appraiser, samples, n_in, n_out))
+                    notes, reader.notes = reader.notes, []
+                    yield StreamBatch(session.push(samples), [], notes, len(samples))
                     raise DataError(str(exc)) from None
                 skipped.append(str(exc))
                 continue
             if sample is not None:
-                samples.append(sample)
-        yield StreamBatch(_push(appraiser, samples, n_in, n_out), skipped)
+                samples.append((sample[0], sample[1]))
+        notes, reader.notes = reader.notes, []
+        yield StreamBatch(session.push(samples), skipped, notes, len(samples))

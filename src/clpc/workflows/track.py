@@ -11,9 +11,12 @@ from typing import Any, Literal
 import numpy as np
 
 from clpc.appraiser import CLPC
+from clpc.appraiser.decimation import Decimator, decimation_factor
+from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
-from clpc.data import DataError
+from clpc.core.figure import MAX_POINTS
+from clpc.data import DataError, IOData
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
 from clpc.io.text_format import sniff
@@ -50,6 +53,9 @@ class TrackSettings:
         Rows read from the file at a time.
     save : str, optional
         Save the steady-state model to this JSON file.
+    figure_updates : int
+        The figures show at most about twice this many updates (evenly thinned); counts,
+        convergence and the steady-state model always come from every update.
     """
 
     record: RecordSpec
@@ -58,10 +64,18 @@ class TrackSettings:
     fmt: TraceFormat = "csv"
     chunk_rows: int = 100_000
     save: str | None = None
+    figure_updates: int = 20_000
 
     def __post_init__(self) -> None:
         check_choice(self.fmt, "fmt", ("csv", "parquet"))
         check_int(self.chunk_rows, "chunk_rows", 1)
+        check_int(self.figure_updates, "figure_updates", 1)
+        record = self.record
+        if self.appraiser.decimate_to is not None and record.dt is None and not record.time_col:
+            raise SettingsError(
+                "--decimate-to is the rate the appraiser works at (the data are decimated to "
+                "it); give the data's own sample time with --dt (or --time) as well."
+            )
 
 
 @dataclass(frozen=True)
@@ -71,7 +85,7 @@ class TrackResult:
     Attributes
     ----------
     summary : dict
-        :func:`clpc.report.trace_summary` of the (thinned) trace.
+        :func:`clpc.report.trace_summary` of every update of the record.
     model : LinearModel or None
         The steady-state model (``None``: no update was accepted).
     model_source : str
@@ -167,6 +181,80 @@ class _Clock:
         self.seen += t.size
 
 
+#: the report compares the model with at most this many (decimated) samples at the end
+#: (its figure then draws every sample: see :data:`clpc.core.figure.MAX_POINTS`)
+REPORT_SAMPLES = MAX_POINTS
+
+
+class _Tail:
+    """The last :data:`REPORT_SAMPLES` rows at the appraiser's rate (bounded memory)."""
+
+    def __init__(self, factor: int) -> None:
+        self.decimator = Decimator(factor)
+        self.rows = np.empty((0, 0))
+
+    def feed(self, values: np.ndarray) -> None:
+        kept = self.decimator(values)
+        both = kept if self.rows.size == 0 else np.concatenate([self.rows, kept])
+        self.rows = both[-REPORT_SAMPLES:]
+
+
+#: the per-update arrays that counts, convergence, findings and the steady-state model use
+_SUMMARY_KEYS = (
+    "theta",
+    "D",
+    "c",
+    "accepted",
+    "has_model",
+    "trusted",
+    "determined",
+    "degenerate",
+    "excited",
+    "n_input_relations",
+    "stable",
+)
+
+
+_RECENT = 20  # updates in the report's table of the last updates
+
+
+def _tail(trace: Trace, n: int) -> Trace:
+    return dataclasses.replace(
+        trace,
+        index=trace.index[-n:],
+        time=trace.time[-n:],
+        rows=trace.rows[-n:],
+        not_enough_data=trace.not_enough_data[-n:],
+        arrays={k: v[-n:] for k, v in trace.arrays.items()},
+    )
+
+
+class _SummaryTrace:
+    """Every update of the run, with only the arrays :func:`trace_summary` reads.
+
+    104 bytes per update for one output with ``order=2`` (6 parameters), a third
+    of a full trace row: a record of 1e7 samples with ``cluster=12`` (8.3e5 updates) keeps
+    about 87 MB.
+    """
+
+    def __init__(self) -> None:
+        self._parts: list[Trace] = []
+        self.last: Trace | None = None
+
+    def add(self, part: Trace) -> None:
+        arrays = {k: part.arrays[k] for k in _SUMMARY_KEYS if k in part.arrays}
+        self._parts.append(dataclasses.replace(part, arrays=arrays))
+        if self.last is not None and len(part) < _RECENT:
+            part = Trace.concat([self.last, part])
+        n = len(part)
+        self.last = part if n <= _RECENT else _tail(part, _RECENT)
+
+    def trace(self) -> Trace:
+        merged = Trace.concat(self._parts)
+        self._parts = [merged]
+        return merged
+
+
 @dataclass
 class _Run:
     """The state of one pass over the record."""
@@ -174,6 +262,8 @@ class _Run:
     appraiser: CLPC
     kept: ThinnedTrace
     n_raw: int
+    tail: _Tail
+    whole: _SummaryTrace = field(default_factory=_SummaryTrace)
 
 
 def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
@@ -193,8 +283,13 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                     )
             if run is None:
                 data_dt = clock.dt if clock is not None else record.dt
-                run = _Run(settings.appraiser.build(data_dt), ThinnedTrace(), 0)
+                kept = ThinnedTrace(settings.figure_updates)
+                appraiser = settings.appraiser.build(data_dt)
+                rate = data_dt if data_dt is not None else appraiser.data_sample_time
+                factor = decimation_factor(appraiser.sample_time, rate)
+                run = _Run(appraiser, kept, 0, _Tail(factor))
             run.n_raw += values.shape[0]
+            run.tail.feed(values[:, : n_in + n_out])
             part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
             if len(part):
                 part = dataclasses.replace(
@@ -204,6 +299,7 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                 )
                 writer.write(part)
                 run.kept.add(part)
+                run.whole.add(part)
     assert run is not None  # iter_table_chunks raises on a file without rows
     return run
 
@@ -227,13 +323,38 @@ def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> 
         )
 
 
+def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
+    """The record's last samples as :class:`IOData` for the report, and where they come from."""
+    rows = run.tail.rows
+    n_in = trace.n_inputs
+    if rows.shape[0] <= trace.structure.max_lag + 1:
+        return {}
+    data = IOData(
+        rows[:, :n_in],
+        rows[:, n_in:],
+        dt=trace.sample_time,
+        input_names=trace.input_names,
+        output_names=trace.output_names,
+    )
+    n = run.appraiser.n_samples
+    where = f"all {n}" if rows.shape[0] >= n else f"the last {rows.shape[0]} of the {n}"
+    note = (
+        f"The model against {where} samples of the record (at the appraiser's sample time): "
+        "a free-run simulation that starts from the first measured samples and then uses "
+        "the input alone."
+    )
+    t0 = (n - rows.shape[0]) * trace.sample_time
+    return {"data": data, "data_note": note, "data_t0": t0}
+
+
 def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
     """Run the CLPC appraiser over a record (read in chunks); write a trace and a report.
 
     Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
     (see :func:`clpc.report.write_track_report`), and the steady-state model if asked.
-    Memory stays bounded whatever the record's length: the figures and the summary use
-    a thinned trace when there are many updates.
+    The figures use a thinned copy of the trace when there are many updates; every count,
+    the convergence point and the steady-state model come from all updates (kept in memory
+    with only the arrays they need, see :class:`_SummaryTrace`).
 
     Parameters
     ----------
@@ -266,22 +387,28 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     run = _appraise(settings, trace_file, progress)
     _check_long_enough(run, settings, trace_file)
     trace = run.kept.trace()
+    whole = run.whole.trace()
     file = settings.record.file
     report_settings = {
         "file": file,
         "samples (after decimation)": run.appraiser.n_samples,
         "updates": run.kept.seen,
-        "updates in figures and summary": f"every {run.kept.stride}"
-        if run.kept.stride > 1
-        else "all",
+        "updates in figures": f"every {run.kept.stride}" if run.kept.stride > 1 else "all",
         **run.appraiser.config(),
     }
-    summary = trace_summary(trace)
+    summary = trace_summary(whole)
+    model, source = steady_state(whole)
     report = write_track_report(
-        out, trace, title=f"CLPC report: {file}", settings=report_settings, summary=summary
+        out,
+        trace,
+        title=f"CLPC track report: {Path(file).name}",
+        settings=report_settings,
+        summary=summary,
+        steady=(model, source),
+        recent=run.whole.last,
+        **_report_data(run, trace),
     )
     files = [trace_file, *report]
-    model, source = steady_state(trace)
     if settings.save and model is not None:
         save_model(model, settings.save)
         files.append(Path(settings.save))

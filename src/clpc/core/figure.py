@@ -1,0 +1,169 @@
+"""Figure primitives shared by every plot: Agg figures, colours per quantity, envelopes.
+
+Kept at the bottom layer so that :meth:`clpc.IOData.plot` and :mod:`clpc.plotting` draw
+alike. matplotlib is imported only when a figure is made (``pip install 'clpc[plot]'``).
+
+* :data:`COLORS` - one colour per quantity (measured, model output, residual, ...), the
+  same in every figure.
+* :func:`new_figure` / :func:`axes_for` - a headless figure, or the caller's axes.
+* :func:`envelope` - min/max of a long signal over bins (vectorised), for drawing.
+* :func:`draw_signal` - a line, or its min/max band when there are too many points.
+* :func:`time_label` / :func:`place_legend`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "COLORS",
+    "MAX_POINTS",
+    "axes_for",
+    "draw_signal",
+    "envelope",
+    "new_figure",
+    "place_legend",
+    "save_figure",
+    "time_label",
+]
+
+INSTALL_HINT = "plotting needs matplotlib: pip install 'clpc[plot]'"
+
+#: the colour of each quantity, the same in every figure
+COLORS: dict[str, str] = {
+    "measured": "#222222",
+    "model": "#d95f02",
+    "prediction": "#7570b3",
+    "residual": "#b2182b",
+    "input": "#1b9e77",
+    "D": "#1f77b4",
+    "theta": "#1f77b4",
+    "not accepted": "#e41a1c",
+    "not determined": "#ff7f00",
+    "few rows": "#bbbbbb",
+    "nyquist": "#777777",
+}
+
+#: above this many samples a signal is drawn as its min/max envelope
+MAX_POINTS = 4000
+
+
+def new_figure(n_rows: int = 1, n_cols: int = 1, *, height: float = 2.6, width: float = 8.0):
+    """A new Agg-backed figure (no pyplot state) and its axes, shape (n_rows, n_cols)."""
+    try:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+    except ImportError:  # pragma: no cover - depends on the environment
+        raise ImportError(INSTALL_HINT) from None
+    fig = Figure(figsize=(width, 0.7 + height * n_rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(n_rows, n_cols, squeeze=False)
+
+
+def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tuple[Any, list]:
+    """The figure and ``n`` axes to draw on: new ones, or the caller's ``ax``.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes, sequence of Axes, or None
+        ``None``: a new figure with ``n`` stacked axes. Otherwise exactly ``n`` axes (a
+        single Axes when ``n == 1``).
+    n : int
+        Panels the plot needs.
+
+    Raises
+    ------
+    ValueError
+        ``ax`` does not hold ``n`` axes.
+    """
+    if ax is None:
+        fig, axes = new_figure(n, 1, height=height, width=width)
+        return fig, list(axes[:, 0])
+    axes = (
+        list(np.ravel(np.asarray(ax, dtype=object)))
+        if isinstance(ax, (Sequence, np.ndarray))
+        else [ax]
+    )
+    if len(axes) != n:
+        raise ValueError(
+            f"this plot needs {n} axes; got {len(axes)}. Pass ax=None for a new figure or "
+            f"a sequence of {n} matplotlib Axes."
+        )
+    return axes[0].get_figure(), axes
+
+
+def save_figure(fig: Any, path: str | PathLike[str] | None) -> None:
+    """Write ``fig`` as PNG to ``path`` (parent folders created); nothing when ``None``."""
+    if path is None:
+        return
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110, format="png")
+
+
+def envelope(
+    x: Any, y: Any, max_points: int = MAX_POINTS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Min and max of ``y`` over ``max_points // 2`` equal bins of samples.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        Abscissa (e.g. time) and values; NaN values are ignored (a bin of NaN only stays NaN).
+    max_points : int
+        Upper bound of points drawn (two per bin).
+
+    Returns
+    -------
+    x_bin : ndarray, shape (n_bins,)
+        ``x`` at the start of each bin (all of ``x`` when ``n <= max_points``).
+    lo, hi : ndarray, shape (n_bins,)
+        Minimum and maximum of ``y`` in each bin (``y`` itself when short).
+    """
+    xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if ya.size <= max_points:
+        return xa, ya, ya
+    starts = np.linspace(0, ya.size, max(max_points // 2, 1), endpoint=False).astype(np.intp)
+    with np.errstate(invalid="ignore"):
+        lo = np.fmin.reduceat(ya, starts)
+        hi = np.fmax.reduceat(ya, starts)
+    return xa[starts], lo, hi
+
+
+def draw_signal(ax: Any, x: Any, y: Any, *, color: str, label: str | None = None, **kw: Any):
+    """Draw ``y(x)`` as a line, or as its min/max band when longer than :data:`MAX_POINTS`."""
+    xb, lo, hi = envelope(x, y)
+    if lo is hi:
+        return ax.plot(xb, lo, color=color, label=label, lw=kw.pop("lw", 1.0), **kw)
+    return ax.fill_between(
+        xb, lo, hi, facecolor=color, edgecolor=color, alpha=0.8, lw=0.4, label=label, step="post"
+    )
+
+
+def time_label(dt: float | None) -> str:
+    """``"time [s]"``, or ``"time [samples]"`` when no sample time was given (``dt`` 1 or None)."""
+    return "time [samples]" if dt is None or dt == 1.0 else "time [s]"
+
+
+def place_legend(ax: Any, *, outside: bool = False, **kw: Any) -> None:
+    """A legend that does not cover the data: above the axes, or to their right."""
+    handles, _ = ax.get_legend_handles_labels()
+    if not handles:
+        return
+    kw.setdefault("fontsize", "small")
+    kw.setdefault("frameon", False)
+    if outside:
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), **kw)
+    else:
+        ax.legend(
+            loc="lower left",
+            bbox_to_anchor=(0.0, 1.0),
+            ncols=min(len(handles), 4),
+            borderaxespad=0.2,
+            **kw,
+        )

@@ -1,0 +1,262 @@
+"""Output-error (OE) estimator: simulation-error least squares, stable by construction.
+
+For each output ``j`` the model ``A(q) y_j = sum_i B_i(q) u_i + k`` (common monic ``A``, one
+``B_i`` per input, ``nk`` leading zeros) is chosen to minimise the free-run simulation error
+
+    sum_n (y_j(n) - y_hat_j(n))^2,     n = max_lag .. T-1,
+
+where ``y_hat`` is simulated from the input alone, started from the measured outputs before
+``max_lag`` (so a record that does not start at rest is fitted exactly). Least squares
+(:class:`clpc.ARX`) minimises the one-step equation error instead; with white noise on the
+output only, that is biased and the simulation error is not.
+
+* **Stable by construction.** ``A`` is parametrised by its reflection coefficients
+  ``kappa_m = MAX_KAPPA tanh(rho_m)`` (the Levinson step-up recursion): every ``rho`` gives a
+  monic ``A`` with all roots strictly inside the unit circle, and every such ``A`` (with
+  ``|kappa_m| < MAX_KAPPA``) has one ``rho``. An integrating process gets a pole just inside.
+* **Two starts.** The search (``scipy.optimize.least_squares``, Levenberg-Marquardt) starts
+  from the least-squares fit and from LPC (``cancel=False``, same structure); an unstable
+  start is first made stable by reflecting its poles ``z -> 1/conj(z)``. The fit with the
+  smaller simulation error is kept (``info["start"]``).
+* **Analytic Jacobian.** ``d y_hat / d a_l = -y_hat(n-l) / A(q)``, ``d y_hat / d b_il =
+  u_i(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``: one ``lfilter`` over all columns, no
+  loop over samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import optimize, signal
+
+from clpc.data import DataError, IOData, as_iodata
+from clpc.lpc.arx import ARX
+from clpc.lpc.estimator import LPC
+from clpc.lpc.reflection import MAX_KAPPA, poly_from_reflection, reflection_from_poly
+from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, lagged
+from clpc.model import LinearModel, ModelError
+
+__all__ = ["OE"]
+
+
+@dataclass
+class _Problem:
+    """One output's simulation-error problem (rows ``n = s .. T-1``)."""
+
+    y: np.ndarray  # (T,) measured output
+    phi_u: np.ndarray  # (T - s, m (nb + 1)) input lags u_i(n - nk - l)
+    na: int
+    s: int  # first simulated sample (max_lag)
+
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """``x = [rho (na); b; k]`` -> ``a``, ``da/drho``, ``b``, ``k``."""
+        t = np.tanh(x[: self.na])
+        a, da = poly_from_reflection(MAX_KAPPA * t)
+        return a, da[1:] * (MAX_KAPPA * (1.0 - t**2))[None, :], x[self.na : -1], float(x[-1])
+
+    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``a`` and ``y_hat(n)`` for ``n >= s``, started from the measured ``y`` before ``s``."""
+        a, _, b, k = self.split(x)
+        forced = self.phi_u @ b + k
+        past = self.y[self.s - self.na : self.s][::-1]  # y(s-1), y(s-2), ..., y(s-na)
+        zi = signal.lfiltic([1.0], a, past)
+        return a, signal.lfilter([1.0], a, forced, zi=zi)[0]
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        return self.y[self.s :] - self.simulate(x)[1]
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        a, da_drho, _, _ = self.split(x)
+        _, y_hat = self.simulate(x)
+        full = np.concatenate([self.y[: self.s], y_hat])
+        y_lags = lagged(full, self.na - 1, 1, self.s)  # y_hat(n-1) .. y_hat(n-na)
+        cols = np.hstack([-y_lags, self.phi_u, np.ones((y_hat.size, 1))])
+        sens = signal.lfilter([1.0], a, cols, axis=0)  # d y_hat / d (a, b, k)
+        jac = -sens
+        return np.hstack([jac[:, : self.na] @ da_drho, jac[:, self.na :]])
+
+
+@dataclass
+class OE:
+    """Output-error estimator: minimise the free-run simulation error (stable models only).
+
+    Parameters
+    ----------
+    order, na, nb, nk, mimo
+        As for :class:`clpc.LPC` (same structure, same :class:`~clpc.model.LinearModel`).
+    max_nfev : int
+        Most residual evaluations per start (Levenberg-Marquardt).
+    starts : tuple of {"arx", "lpc"}
+        The closed-form fits that start the search (default both).
+    initial : LinearModel, optional
+        An extra start (same structure and channels), tried beside ``starts``.
+
+    Notes
+    -----
+    The fit is local: it improves on the best of its starts and can stop in a local
+    minimum. ``info`` holds per output ``start`` (which start won: ``"arx"``, ``"lpc"`` or
+    ``"initial"``), ``cost`` (``sum of squared simulation errors / 2``), ``start_costs``
+    (the final cost from each start), ``nfev`` and ``success``.
+    """
+
+    order: int = 2
+    na: int | None = None
+    nb: int | None = None
+    nk: int = 0
+    mimo: MimoMode | None = None
+    max_nfev: int = 200
+    starts: tuple[str, ...] = ("arx", "lpc")
+    initial: LinearModel | None = None
+
+    def structure(self) -> Structure:
+        """The :class:`Structure` these settings describe."""
+        return Structure.from_settings(self.order, self.na, self.nb, self.nk)
+
+    def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
+        """Output-error fit; returns a stable :class:`LinearModel` (``theta`` unit norm).
+
+        Parameters
+        ----------
+        u : IOData or array_like, shape (T,) or (T, n_inputs)
+            The record, or its inputs.
+        y : array_like, shape (T,) or (T, n_outputs), optional
+            Outputs (when ``u`` is not an :class:`IOData`).
+        dt : float, optional
+            Sample time [s].
+
+        Returns
+        -------
+        LinearModel
+
+        Raises
+        ------
+        DataError
+            Invalid data or too few samples.
+        """
+        if not isinstance(self.max_nfev, int) or self.max_nfev < 1:
+            raise ValueError(f"max_nfev must be an int >= 1; got {self.max_nfev!r}.")
+        unknown = set(self.starts) - {"arx", "lpc"}
+        if unknown or not (self.starts or self.initial is not None):
+            raise ValueError(
+                f"starts must name 'arx' and/or 'lpc' (or pass initial=); got {self.starts!r}."
+            )
+        data = as_iodata(u, y, dt)
+        structure = self.structure()
+        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
+        check_mode(mode, data.n_inputs, data.n_outputs)
+        n_blocks = data.n_inputs if mode == "miso" else 1
+        p = structure.n_params(n_blocks)
+        data.require_samples(structure.max_lag + p + 2, f"An OE fit with {p} parameters")
+        starts = self._starts(data, structure, mode)
+        thetas, cs = [], []
+        info: dict[str, Any] = {"method": "output-error"}
+        per_output: list[dict[str, Any]] = []
+        for j in range(data.n_outputs):
+            cols = range(data.n_inputs) if mode == "miso" else [j]
+            prob = _Problem(
+                data.y[:, j],
+                np.hstack(
+                    [
+                        lagged(data.u[:, i], structure.nb, structure.nk, structure.max_lag)
+                        for i in cols
+                    ]
+                ),
+                structure.na,
+                structure.max_lag,
+            )
+            fits = {}
+            for name, model in starts.items():
+                x0 = _start_vector(model, j, list(cols), structure)
+                res = optimize.least_squares(
+                    prob.residual,
+                    x0,
+                    jac=prob.jacobian,
+                    method="lm",
+                    x_scale="jac",
+                    xtol=1e-14,
+                    ftol=1e-14,
+                    gtol=1e-14,
+                    max_nfev=self.max_nfev,
+                )
+                if np.isfinite(res.cost):
+                    fits[name] = res
+            if not fits:
+                raise DataError(
+                    f"the output-error search diverged from every start for output {j}; "
+                    "check the record (scaling, constant channels) or lower the order."
+                )
+            best = min(fits, key=lambda name: fits[name].cost)
+            a, _, b, k = prob.split(fits[best].x)
+            theta = np.concatenate([a, -b])
+            scale = np.linalg.norm(theta)
+            thetas.append(theta / scale)
+            cs.append(k / scale)
+            per_output.append(
+                {
+                    "start": best,
+                    "cost": float(fits[best].cost),
+                    "start_costs": {n: float(r.cost) for n, r in fits.items()},
+                    "nfev": int(fits[best].nfev),
+                    "success": bool(fits[best].success),
+                }
+            )
+        for key in ("start", "cost", "nfev", "success"):
+            info[key] = np.array([row[key] for row in per_output])
+        info["start_costs"] = [row["start_costs"] for row in per_output]
+        return LinearModel(
+            theta=np.array(thetas),
+            structure=structure,
+            n_inputs=data.n_inputs,
+            mode=mode,
+            c=np.array(cs),
+            dt=data.dt,
+            input_names=data.input_names,
+            output_names=data.output_names,
+            info=info,
+        )
+
+    def _starts(self, data: IOData, structure: Structure, mode: str) -> dict[str, LinearModel]:
+        """The least-squares and LPC fits (and ``initial``) that start the search."""
+        kw: dict[str, Any] = {
+            "order": self.order,
+            "na": self.na,
+            "nb": self.nb,
+            "nk": self.nk,
+            "mimo": mode,
+        }
+        starts: dict[str, LinearModel] = {}
+        if "arx" in self.starts:
+            starts["arx"] = ARX(**kw).fit(data)
+        if "lpc" in self.starts:
+            try:
+                lpc = LPC(**kw, cancel=False).fit(data)
+                lpc.denominators  # a0 must be nonzero  # noqa: B018
+                starts["lpc"] = lpc
+            except (ModelError, DataError):
+                pass  # LPC found no relation with y(n) in it: the others start alone
+        if self.initial is not None:
+            init = self.initial
+            if (
+                init.structure != structure
+                or init.n_inputs != data.n_inputs
+                or (init.n_outputs != data.n_outputs)
+            ):
+                raise ValueError(
+                    f"initial must have the structure {structure} and {data.n_inputs} "
+                    f"input(s), {data.n_outputs} output(s); got {init!r}."
+                )
+            starts["initial"] = init
+        return starts
+
+
+def _start_vector(model: LinearModel, j: int, cols: list[int], structure: Structure) -> np.ndarray:
+    """``[rho; b; k]`` of output ``j`` of a start model (made stable first)."""
+    den = model.denominators[j]
+    kappa = np.clip(reflection_from_poly(den), -MAX_KAPPA * (1 - 1e-12), MAX_KAPPA * (1 - 1e-12))
+    b = np.concatenate([model.numerators[j, i, structure.nk :] for i in cols])
+    x0 = np.concatenate([np.arctanh(kappa / MAX_KAPPA), b, [model.intercept[j]]])
+    if not np.all(np.isfinite(x0)):
+        raise ModelError(f"the start model of output {j} has non-finite parameters.")
+    return x0

@@ -1,0 +1,326 @@
+"""``clpc.MultiModel``: local linear models blended by validity functions of one variable.
+
+>>> import numpy as np, clpc
+>>> rng = np.random.default_rng(0)
+>>> u = rng.standard_normal(3000)
+>>> y = clpc.simulate_arx([1, -0.5], [0, 1.0], u)
+>>> mm = clpc.MultiModel(order=1).fit(u, y, dt=0.01)   # a linear plant: one model suffices
+>>> mm.n_models, round(float(clpc.fit_percent(y, mm.simulate(u))), 3)
+(1, 100.0)
+
+The one-step equation is ``y(n) = sum_i phi_i(psi(n)) yhat_i(n)``: each local model's
+monic one-step output (:class:`clpc.LinearModel` conventions) weighted by its validity
+(:mod:`clpc.multimodel.validity`) at the scheduling value ``psi(n)``
+(:mod:`clpc.multimodel.schedule`). Fitting: :mod:`clpc.multimodel.fitting`; local models
+and their stability guard: :mod:`clpc.multimodel.local`; saving: :mod:`clpc.multimodel.store`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from clpc.data import as_iodata
+from clpc.model import LinearModel
+from clpc.model.errors import as_2d
+from clpc.model.structure import Structure
+from clpc.multimodel.fitting import Fitted, Windows, blend_run, fit_all, monic_arrays, own_windows
+from clpc.multimodel.prediction import predict_kstep
+from clpc.multimodel.schedule import Schedule, parse_schedule
+from clpc.multimodel.validity import validity
+
+__all__ = ["MultiModel"]
+
+
+class MultiModel:
+    """A multi-model of local LPC models (single output, one or more inputs).
+
+    Parameters
+    ----------
+    order : int
+        ``na = nb = order`` of every local model (default 2, the paper's ``N``).
+    na, nb, nk : int, optional
+        Separate orders and input delay.
+    n_models : int, optional
+        Number of local models; default chosen by held-out free-run fit.
+    max_models : int
+        Largest number tried by the automatic choice (default 8).
+    schedule : {"y", "u"}, int or callable
+        Scheduling variable (default ``"y"``: ``y(n-1)``), see :mod:`clpc.multimodel.schedule`.
+    estimator : {"auto", "lpc", "ls"}
+        Local estimator: validity-weighted LPC with the stability guard (an unstable local
+        LPC model is refitted by weighted least squares and flagged), weighted least
+        squares, or ``"auto"`` (default): both are scored on the held-out part and LPC is
+        kept unless least squares free-runs better by more than ``tolerance``.
+    window_size, cluster_size : int
+        Windows whose operating points place the centres in :meth:`fit` (Table 1: 201, 12);
+        :meth:`from_trace` uses the trace's own windows.
+    holdout : float
+        Share of the record held out to choose ``n_models`` (default 0.3).
+    tolerance : float
+        Points of held-out fit within which fewer models are preferred (default 0.5).
+    method : {"robust", "paper"}
+        LPC solution (see :class:`clpc.LPC`).
+    engine : {"auto", "compiled", "python"}
+        Free-run loop: compiled by numba, or plain Python.
+    """
+
+    def __init__(
+        self,
+        order: int = 2,
+        *,
+        na: int | None = None,
+        nb: int | None = None,
+        nk: int = 0,
+        n_models: int | None = None,
+        max_models: int = 8,
+        schedule: Any = "y",
+        estimator: str = "auto",
+        window_size: int = 201,
+        cluster_size: int = 12,
+        holdout: float = 0.3,
+        tolerance: float = 0.5,
+        method: str = "robust",
+        engine: str = "auto",
+    ) -> None:
+        self.structure = Structure.from_settings(order, na, nb, nk)
+        for name, value, low in (
+            ("n_models", n_models, 1),
+            ("max_models", max_models, 1),
+            ("window_size", window_size, 2),
+            ("cluster_size", cluster_size, 1),
+        ):
+            if value is None and name == "n_models":
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ValueError(f"{name} must be an int >= {low}; got {value!r}.")
+        if estimator not in ("auto", "lpc", "ls"):
+            raise ValueError(f"estimator must be 'auto', 'lpc' or 'ls'; got {estimator!r}.")
+        if not 0.05 <= float(holdout) <= 0.5:
+            raise ValueError(f"holdout must be a share in [0.05, 0.5]; got {holdout!r}.")
+        if not float(tolerance) >= 0:
+            raise ValueError(f"tolerance must be >= 0 points; got {tolerance!r}.")
+        self.settings: dict[str, Any] = {
+            "n_models": None if n_models is None else int(n_models),
+            "max_models": int(max_models),
+            "estimator": estimator,
+            "window_size": int(window_size),
+            "cluster_size": int(cluster_size),
+            "holdout": float(holdout),
+            "tolerance": float(tolerance),
+            "method": method,
+            "engine": engine,
+        }
+        self.schedule_spec = schedule
+        self._fitted: Fitted | None = None
+        self.n_inputs = 1
+        self.dt = 1.0
+
+    # ----------------------------------------------------------------- fitting
+    def _schedule(self) -> Schedule:
+        return parse_schedule(self.schedule_spec, self.structure, self.n_inputs)
+
+    def _fit(self, u: Any, y: Any, dt: Any, windows: Windows | None) -> MultiModel:
+        data = as_iodata(u, y, dt)
+        if data.n_outputs != 1:
+            raise ValueError(
+                f"MultiModel fits one output; got {data.n_outputs}. Fit one per output."
+            )
+        self.n_inputs, self.dt = data.n_inputs, float(data.dt)
+        sched = self._schedule()
+        start = max(self.structure.max_lag, sched.lag)
+        p = self.structure.n_params(self.n_inputs)
+        data.require_samples(start + 10 * p, f"A multi-model with {p} parameters per model")
+        if windows is None:
+            s = self.settings
+            windows = own_windows(start, data.n_samples, s["window_size"], s["cluster_size"])
+        cfg = dict(self.settings, structure=self.structure, n_inputs=self.n_inputs, dt=self.dt)
+        self._fitted = fit_all(data.u, data.y[:, 0], sched, windows, cfg)
+        return self
+
+    def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> MultiModel:
+        """Fit centres, local models and (unless given) their number; returns ``self``.
+
+        Parameters
+        ----------
+        u : IOData or array_like, shape (T,) or (T, n_inputs)
+        y : array_like, shape (T,)
+        dt : float, optional
+            Sample time [s].
+        """
+        return self._fit(u, y, dt, None)
+
+    @classmethod
+    def from_trace(cls, trace: Any, u: Any, y: Any, **settings: Any) -> MultiModel:
+        """A multi-model whose centres come from a CLPC trace's windows (when they are local).
+
+        The structure is the trace's; the windows are its trusted ones; ``u``, ``y`` are the
+        record the trace was computed on (at the trace's sample time). ``settings`` are the
+        other constructor arguments.
+        """
+        s = trace.structure
+        mm = cls(na=s.na, nb=s.nb, nk=s.nk, **settings)
+        ok = np.asarray(trace.arrays["trusted"]).all(axis=1) & ~np.asarray(trace.not_enough_data)
+        if not ok.any():
+            raise ValueError("the trace has no trusted window: nothing places the centres.")
+        windows = Windows(
+            np.asarray(trace.index)[ok],
+            np.asarray(trace.rows)[ok],
+            "the CLPC trace's trusted windows",
+        )
+        return mm._fit(u, y, trace.sample_time, windows)
+
+    # ----------------------------------------------------------------- views
+    def _require(self) -> Fitted:
+        if self._fitted is None:
+            raise ValueError("the multi-model is not fitted: call fit() or from_trace() first.")
+        return self._fitted
+
+    @property
+    def local_models(self) -> list[LinearModel]:
+        """The local models (``info``: ``estimator``, ``replaced``, ``weight``)."""
+        return list(self._require().local_models)
+
+    @property
+    def n_models(self) -> int:
+        """Number of local models."""
+        return len(self._require().local_models)
+
+    @property
+    def centres(self) -> np.ndarray:
+        """Centres of the validity functions (scheduling-variable units), shape (M,)."""
+        return self._require().centres.copy()
+
+    @property
+    def widths(self) -> np.ndarray:
+        """Widths of the validity functions, shape (M,) (inf for a single model)."""
+        return self._require().widths.copy()
+
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """How the model was built: centre source and why, selection table, replaced models."""
+        return dict(self._require().diagnostics)
+
+    def validity(self, psi: Any) -> np.ndarray:
+        """Validities of every local model at ``psi``: shape ``psi.shape + (M,)``, rows sum to 1."""
+        f = self._require()
+        return validity(psi, f.centres, f.widths)
+
+    # ----------------------------------------------------------------- time domain
+    def simulate(
+        self, u: Any, *, y_init: Any | None = None, u_init: Any | None = None
+    ) -> np.ndarray:
+        """Free-run simulation from the input alone (compiled loop).
+
+        Parameters
+        ----------
+        u : array_like, shape (T,) or (T, n_inputs)
+        y_init : array_like, optional
+            Outputs before ``u[0]``, oldest first (at least ``na``; more are used only by a
+            schedule on an older lag). Default zeros.
+        u_init : array_like, optional
+            Inputs before ``u[0]``, oldest first. Default zeros.
+
+        Returns
+        -------
+        ndarray, shape (T,)
+        """
+        f = self._require()
+        sched = self._schedule()
+        u2, _ = as_2d(u, self.n_inputs, "u")
+        s = self.structure
+        pad = max(s.na, s.nk + s.nb, sched.lag, 1)
+        y_ext = np.zeros(pad + u2.shape[0])
+        u_ext = np.zeros((pad + u2.shape[0], self.n_inputs))
+        u_ext[pad:] = u2
+        if y_init is not None:
+            y0 = np.asarray(y_init, dtype=np.float64).ravel()[-pad:]
+            y_ext[pad - y0.size : pad] = y0
+        if u_init is not None:
+            u0, _ = as_2d(u_init, self.n_inputs, "u_init")
+            u0 = u0[-pad:]
+            u_ext[pad - u0.shape[0] : pad] = u0
+        engine = self.settings["engine"]
+        arrays = monic_arrays(f.local_models)
+        with np.errstate(all="ignore"):
+            blend_run(arrays, f.centres, f.widths, sched, u_ext, y_ext, pad, engine)
+        return y_ext[pad:]
+
+    def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
+        """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data (vectorised).
+
+        The first ``max(max_lag, schedule lag)`` samples are returned as measured; each
+        step feeds the previous step's predictions into the output lags and the schedule.
+
+        Returns
+        -------
+        ndarray, shape (T,)
+        """
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"k must be an int >= 1; got {k!r}.")
+        f = self._require()
+        sched = self._schedule()
+        u2, _ = as_2d(u, self.n_inputs, "u")
+        y1 = np.asarray(y, dtype=np.float64).ravel()
+        if u2.shape[0] != y1.shape[0]:
+            raise ValueError(
+                f"u and y must have the same length; got {u2.shape[0]}, {y1.shape[0]}."
+            )
+        return predict_kstep(monic_arrays(f.local_models), f, sched, self.structure, u2, y1, k)
+
+    def linearize(self, operating_point: float) -> LinearModel:
+        """The frozen-validity local model at a scheduling value (a :class:`LinearModel`).
+
+        Its monic coefficients are the validity-weighted means of the local models' at
+        ``psi = operating_point`` (the scheduling variable held there; the derivative of
+        the validities is left out).
+        """
+        f = self._require()
+        den, num, icpt = monic_arrays(f.local_models)
+        phi = validity(np.float64(operating_point), f.centres, f.widths)
+        d, nm, ic = phi @ den, np.tensordot(phi, num, axes=1), float(phi @ icpt)
+        s = self.structure
+        theta = np.concatenate([d, *(-nm[c, s.nk :] for c in range(self.n_inputs))])
+        scale = float(np.linalg.norm(theta))
+        return LinearModel(
+            theta=np.atleast_2d(theta / scale),
+            structure=s,
+            n_inputs=self.n_inputs,
+            mode="siso" if self.n_inputs == 1 else "miso",
+            c=np.array([ic / scale]),
+            dt=self.dt,
+            info={"method": "multimodel-linearization", "operating_point": float(operating_point)},
+        )
+
+    # ----------------------------------------------------------------- files
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe description (floats exact); see :mod:`clpc.multimodel.store`."""
+        from clpc.multimodel.store import to_dict
+
+        return to_dict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> MultiModel:
+        """Rebuild a multi-model from :meth:`to_dict` output."""
+        from clpc.multimodel.store import from_dict
+
+        return from_dict(cls, data)
+
+    def save(self, path: Any) -> None:
+        """Write :meth:`to_dict` as JSON to ``path``."""
+        from clpc.multimodel.store import save
+
+        save(self, path)
+
+    @classmethod
+    def load(cls, path: Any) -> MultiModel:
+        """Read a multi-model written by :meth:`save`."""
+        from clpc.multimodel.store import load
+
+        return load(cls, path)
+
+    def __repr__(self) -> str:
+        s = self.structure
+        m = "unfitted" if self._fitted is None else f"n_models={self.n_models}"
+        return f"MultiModel(na={s.na}, nb={s.nb}, nk={s.nk}, {m}, schedule={self.schedule_spec!r})"

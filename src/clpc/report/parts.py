@@ -1,0 +1,144 @@
+"""Report sections about one model: its equations, its fit on data, its responses.
+
+Shared by the track report (:mod:`clpc.report.track`) and the identify report
+(:mod:`clpc.report.identify`), so both read alike: results first, settings last.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from clpc.model import LinearModel, fit_verdict
+from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
+from clpc.report.html import Section
+from clpc.report.summaries import model_summary
+from clpc.report.text import format_fit, format_model_summary
+
+__all__ = ["model_sections", "model_warnings", "settings_section"]
+
+#: verdict messages that are good news (everything else is shown as a warning)
+_GOOD = ("the data determine", "the model is stable", "no fit statistics")
+
+
+def model_warnings(model: LinearModel) -> list[str]:
+    """The problems the verdict of each output finds, in plain words (may be empty).
+
+    Uses :func:`clpc.fit_verdict` (excitation, determination, cancelled factors,
+    stability); a multi-output model prefixes each message with the output's name.
+    """
+    out = []
+    for j, name in enumerate(model.output_names):
+        for msg in fit_verdict(model, j).messages:
+            if not msg.startswith(_GOOD):
+                out.append(msg if model.n_outputs == 1 else f"{name}: {msg}")
+    return out
+
+
+def fit_table(summary: Mapping[str, Any]) -> list[list[Any]]:
+    """Rows ``[output, simulation fit, k-step fits...]`` of :func:`model_summary` with data."""
+    fits = summary.get("fit", {})
+    head = ["output", *(k.replace("prediction_", "") + "-step prediction" if k != "simulation"
+                        else "free-run simulation" for k in fits)]  # fmt: skip
+    rows: list[list[Any]] = [head]
+    for j, name in enumerate(summary["outputs"]):
+        rows.append([name, *(format_fit(vals[j]) for vals in fits.values())])
+    return rows
+
+
+def model_sections(
+    model: LinearModel,
+    out: Path,
+    *,
+    data: Any = None,
+    data_note: str = "",
+    data_t0: float = 0.0,
+) -> tuple[list[Section], list[Path]]:
+    """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
+
+    Parameters
+    ----------
+    model : LinearModel
+    out : Path
+        Folder for the figures ``fit.png``, ``data.png``, ``step.png``, ``bode.png``,
+        ``pz.png``.
+    data : IOData, optional
+        Record to compare the model with (the fit figures are left out without it).
+    data_note : str
+        Where the compared samples come from (shown under the fit figure).
+    data_t0 : float
+        Time of ``data``'s first sample in the whole record (the fit figure's time axis).
+
+    Returns
+    -------
+    sections : list of Section
+    files : list of Path
+        The figures written.
+    """
+    summary = model_summary(model, data)
+    files: list[Path] = []
+    sections = [
+        Section(
+            "Model",
+            html=model._repr_html_(),
+            table=fit_table(summary) if data is not None else None,
+        )
+    ]
+    if data is not None:
+        fit_png, data_png = out / "fit.png", out / "data.png"
+        plot_fit(model, data, fit_png, t0=data_t0)
+        plot_data(data, data_png, t0=data_t0, title=f"the compared {data.n_samples} samples")
+        files += [fit_png, data_png]
+        sections.append(
+            Section(
+                "Measured data, model output and residuals",
+                text=data_note,
+                images=[
+                    (fit_png, "measured output, free-run simulation and residual"),
+                    (data_png, "the compared record, every channel"),
+                ],
+            )
+        )
+    step_png, bode_png, pz_png = out / "step.png", out / "bode.png", out / "pz.png"
+    plot_step(model, step_png)
+    plot_bode(model, bode_png)
+    plot_pz(model, pz_png)
+    files += [step_png, bode_png, pz_png]
+    sections.append(
+        Section(
+            "Step and frequency response",
+            text="Unit step of every channel from rest (offset left out); Bode plot on a "
+            "log-spaced grid over three decades up to the Nyquist frequency (dashed).",
+            images=[
+                (step_png, "step response"),
+                (bode_png, "Bode plot"),
+                (pz_png, "poles and zeros"),
+            ],
+        )
+    )
+    sections.append(
+        Section(
+            "Model as text (as the command line prints it)",
+            preformatted=format_model_summary(summary),
+            collapsed=True,
+        )
+    )
+    return sections, files
+
+
+def settings_section(settings: Mapping[str, Any]) -> Section:
+    """The run's settings as a collapsed table (nested mappings flattened as ``a.b``)."""
+    flat: dict[str, Any] = {}
+
+    def add(prefix: str, values: Mapping[str, Any]) -> None:
+        for k, v in values.items():
+            if isinstance(v, Mapping):
+                add(f"{prefix}{k}.", v)
+            else:
+                flat[f"{prefix}{k}"] = v
+
+    add("", settings)
+    if not flat:
+        return Section("Settings", text="No settings were recorded.", collapsed=True)
+    return Section("Settings", table=flat, collapsed=True)

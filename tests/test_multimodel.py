@@ -1,0 +1,225 @@
+"""Multi-models (issue 18): the crank servo, MultiModel, operating-point diagnostics."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import clpc
+from clpc import datasets
+from clpc.analysis.operating_point import operating_point_diagnostics
+from clpc.lpc.heldout import fit_percent
+from clpc.multimodel import simulate_time_varying
+from clpc.multimodel.local import fit_local, weighted_lpc
+from clpc.multimodel.validity import validity
+from clpc.plants.crank_servo import (
+    CrankParameters,
+    crank_commands,
+    crank_operating_point,
+    simulate_crank_servo,
+)
+
+NONLINEAR = CrankParameters()
+CONTROL = CrankParameters(velocity_integrator=10.0)
+
+
+def _records(params: CrankParameters, seed: int, n_levels: int = 30):
+    ident = simulate_crank_servo(crank_commands(n_levels, seed=seed), seed=seed + 1, params=params)
+    val = simulate_crank_servo(crank_commands(15, seed=seed + 10), seed=seed + 11, params=params)
+    return ident, val
+
+
+def _free_run(model, u, y, na=2):
+    sim = model.simulate(u[na:], y_init=y[:na], u_init=u[:na])
+    return fit_percent(y[na:], sim)
+
+
+@pytest.fixture(scope="module")
+def nonlinear():
+    ident, val = _records(NONLINEAR, 1)
+    mm = clpc.MultiModel().fit(ident.command, ident.position, dt=0.01)
+    return ident, val, mm
+
+
+def test_crank_rests_where_the_closed_form_says():
+    levels = np.repeat([0.0, 1.0, 2.0, 2.8], 300)  # 3 s per level, no dither
+    prm = CrankParameters(position_noise_std=0.0, resolution=0.0, coulomb_friction=0.0)
+    rec = simulate_crank_servo(levels, params=prm, seed=0)
+    rest, gain, poles = crank_operating_point(np.array([0.0, 1.0, 2.0, 2.8]), prm)
+    np.testing.assert_allclose(rec.true_position[299::300], rest, atol=1e-6)
+    # r = y + (m g r / (Kv Kp)) sin y, and the local gain is its inverse slope
+    a = prm.gravity_torque / (prm.velocity_gain * prm.position_gain)
+    np.testing.assert_allclose(rest + a * np.sin(rest), [0.0, 1.0, 2.0, 2.8], atol=1e-12)
+    np.testing.assert_allclose(gain, 1.0 / (1.0 + a * np.cos(rest)), rtol=1e-12)
+    assert gain[0] == pytest.approx(0.671, abs=1e-3) and poles.shape == (4, 2)
+
+
+def test_crank_engines_agree_and_inputs_are_checked():
+    cmd = crank_commands(2, hold=1.0, seed=3)
+    fast = simulate_crank_servo(cmd, seed=4)
+    slow = simulate_crank_servo(cmd, seed=4, engine="python")
+    np.testing.assert_allclose(fast.position, slow.position, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="controller_rate"):
+        simulate_crank_servo(cmd, sample_time=0.0015)
+    with pytest.raises(ValueError, match="velocity_gain"):
+        CrankParameters(velocity_gain=0.0)
+
+
+def test_multimodel_beats_global_least_squares_on_the_crank_servo(nonlinear):
+    ident, val, mm = nonlinear
+    ls = clpc.ARX(order=2).fit(ident.command, ident.position, dt=0.01)
+    gain = _free_run(mm, val.command, val.position) - _free_run(ls, val.command, val.position)
+    assert gain >= 10.0, gain
+    assert mm.diagnostics["centre_source"] == "windows"
+    assert mm.n_models >= 3
+
+
+@pytest.mark.parametrize("case", ["control", "arx"])
+def test_no_harm_where_there_is_nothing_to_gain(case):
+    if case == "control":
+        ident, val = _records(CONTROL, 5)
+        u, y, vu, vy = ident.command, ident.position, val.command, val.position
+    else:
+        rng = np.random.default_rng(7)
+        u = rng.standard_normal(6000)
+        x = clpc.simulate_arx([1, -1.5, 0.7], [0, 0.5, 0.3], u)
+        y = x + 0.05 * rng.standard_normal(u.size)
+        vu = rng.standard_normal(3000)
+        vy = clpc.simulate_arx([1, -1.5, 0.7], [0, 0.5, 0.3], vu)
+    mm = clpc.MultiModel().fit(u, y, dt=0.01)
+    # the global fit: the better of one global LPC and one global least-squares model
+    best = max(
+        _free_run(est.fit(u, y, dt=0.01), vu, vy) for est in (clpc.LPC(order=2), clpc.ARX(order=2))
+    )
+    assert abs(_free_run(mm, vu, vy) - best) <= 1.0
+
+
+def test_validity_sums_to_one_and_one_step_is_the_blended_equation(nonlinear):
+    _ident, val, mm = nonlinear
+    psi = np.linspace(-5, 10, 301)
+    phi = mm.validity(psi)
+    np.testing.assert_allclose(phi.sum(axis=1), 1.0, rtol=0, atol=1e-12)
+    assert np.all(phi >= 0)
+    u, y = val.command[:2000], val.position[:2000]
+    # independent reference: every local LinearModel's own one-step prediction, blended by
+    # the validities of the measured y(n-1)
+    local = np.stack([m.predict(u, y, k=1) for m in mm.local_models], axis=1)
+    w = validity(y[1:-1], mm.centres, mm.widths)
+    ref = (w * local[2:]).sum(axis=1)
+    np.testing.assert_allclose(mm.predict(u, y, k=1)[2:], ref, rtol=0, atol=1e-12)
+    # k steps: the free run of a k-sample stretch equals the k-step prediction at its end
+    k, n = 10, 1500
+    pred = mm.predict(u, y, k=k)
+    sim = mm.simulate(
+        u[n - k + 1 : n + 1], y_init=y[n - k - 1 : n - k + 1], u_init=u[n - k - 1 : n - k + 1]
+    )
+    assert pred[n] == pytest.approx(sim[-1], abs=1e-12)
+
+
+def test_json_round_trip_is_exact(nonlinear, tmp_path):
+    _, val, mm = nonlinear
+    path = tmp_path / "mm.json"
+    mm.save(path)
+    back = clpc.MultiModel.load(path)
+    a = mm.simulate(val.command, y_init=val.position[:2])
+    b = back.simulate(val.command, y_init=val.position[:2])
+    assert np.array_equal(a, b)
+    assert back.diagnostics["centre_source"] == mm.diagnostics["centre_source"]
+    with pytest.raises(ValueError, match="format"):
+        clpc.MultiModel.from_dict(json.loads('{"format": "other"}'))
+
+
+def test_engines_and_linearisation(nonlinear):
+    _, val, mm = nonlinear
+    u = val.command[:1500]
+    fast = mm.simulate(u, y_init=val.position[:2])
+    mm.settings["engine"] = "python"
+    try:
+        slow = mm.simulate(u, y_init=val.position[:2])
+    finally:
+        mm.settings["engine"] = "auto"
+    np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-12)
+    # the local DC gain follows the closed form of the crank (0.67 at the bottom, 1 at
+    # horizontal): loose, since the local models blend neighbours
+    rest, gain, _ = crank_operating_point(np.array([0.0, np.pi / 2 + 0.49]))
+    got = [float(mm.linearize(r).dc_gain()[0, 0]) for r in rest]
+    np.testing.assert_allclose(got, gain, rtol=0.15)
+
+
+def test_unstable_local_lpc_is_replaced_and_flagged():
+    # the cascaded tanks (real data): local LPC models of the low levels come out unstable
+    est, _ = datasets.load("cascaded_tanks")
+    u, y = est.u[:, 0], est.y[:, 0]
+    mm = clpc.MultiModel(estimator="lpc", n_models=4).fit(u, y, dt=est.dt)
+    replaced = mm.diagnostics["replaced"]
+    assert replaced
+    s = mm.structure
+    rows = np.column_stack([y[2:], y[1:-1], y[:-2], u[2:], u[1:-1], u[:-2]])
+    for i, model in enumerate(mm.local_models):
+        w = mm.validity(y[1:-1])[:, i]
+        theta, _c, _ = weighted_lpc(rows, w, s, 1)
+        unguarded = np.max(np.abs(np.roots(theta[:3] / theta[0])))
+        assert (i in replaced) == (unguarded > 1.0 + 5e-3), (i, unguarded)
+        assert model.info["replaced"] == (i in replaced)
+        if i in replaced:  # refitted by weighted least squares: stable, and flagged
+            assert model.info["estimator"] == "least-squares"
+            assert np.max(np.abs(model.poles())) < 1.0
+            ls = fit_local(rows, w, s, 1, estimator="ls")
+            np.testing.assert_array_equal(model.theta, ls.theta)
+
+
+def test_cascaded_tanks_no_worse_than_least_squares():
+    est, val = datasets.load("cascaded_tanks")
+    u, y, vu, vy = est.u[:, 0], est.y[:, 0], val.u[:, 0], val.y[:, 0]
+    mm = clpc.MultiModel().fit(u, y, dt=est.dt)
+    ls = clpc.ARX(order=2).fit(u, y, dt=est.dt)
+    assert _free_run(mm, vu, vy) >= _free_run(ls, vu, vy) - 2.0
+
+
+def test_operating_point_diagnostics_and_steady_state_warning(nonlinear):
+    ident, _, _ = nonlinear
+    trace = clpc.CLPC(3, 201, 12).run(ident.command, ident.position, dt=0.01)
+    rep = operating_point_diagnostics(trace, ident.command, ident.position)
+    assert rep.multimodel_recommended and rep.windows_local
+    assert "multi-model is recommended" in rep.verdict
+    with pytest.warns(UserWarning, match="MODELS CHANGE WITH THE OUTPUT LEVEL"):
+        trace.steady_state_model()
+    mm = clpc.MultiModel.from_trace(trace, ident.command, ident.position)
+    assert mm.diagnostics["windows"] == "the CLPC trace's trusted windows"
+    # a linear plant: no recommendation, no warning
+    rng = np.random.default_rng(2)
+    u = rng.standard_normal(6000)
+    y = clpc.simulate_arx([1, -1.5, 0.7], [0, 0.5, 0.3], u) + 0.01 * rng.standard_normal(6000)
+    lin = clpc.CLPC(3, 201, 12).run(u, y, dt=0.01)
+    assert not operating_point_diagnostics(lin, u, y).multimodel_recommended
+
+
+def test_oscillating_windows_take_centres_from_the_samples():
+    # every window sweeps the whole range: window means cannot isolate operating points
+    t = np.arange(8000) * 0.01
+    u = np.sin(2 * np.pi * 1.0 * t) + 0.05 * np.random.default_rng(1).standard_normal(t.size)
+    y = clpc.simulate_arx([1, -0.5], [0, 0.5], u) + 0.1 * np.tanh(3 * u)
+    mm = clpc.MultiModel(order=1, n_models=3).fit(u, y, dt=0.01)
+    assert mm.diagnostics["centre_source"] == "samples"
+    assert "cannot isolate" in mm.diagnostics["centre_reason"]
+
+
+def test_time_varying_free_run_matches_a_constant_model():
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(500)
+    den, num = np.array([1.0, -1.2, 0.5]), np.array([0.0, 0.4, 0.2])
+    ref = clpc.simulate_arx(den, num, u)
+    t = u.size
+    y = simulate_time_varying(np.tile(den, (t, 1)), np.tile(num, (t, 1)), np.zeros(t), u, ref[:2])
+    np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12)
+
+
+def test_bad_arguments_are_refused():
+    with pytest.raises(ValueError, match="schedule"):
+        clpc.MultiModel(schedule="z").fit(np.ones(100), np.arange(100.0), dt=1.0)
+    with pytest.raises(ValueError, match="estimator"):
+        clpc.MultiModel(estimator="svm")
+    with pytest.raises(ValueError, match="not fitted"):
+        clpc.MultiModel().simulate(np.ones(10))

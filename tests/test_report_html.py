@@ -1,0 +1,243 @@
+"""The HTML reports a person reads: valid, self-contained, results before settings."""
+
+from __future__ import annotations
+
+import base64
+import shutil
+import subprocess
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import clpc
+import clpc.datasets as ds
+from clpc import plotting, report
+
+pytest.importorskip("matplotlib")
+
+PNG = b"\x89PNG\r\n\x1a\n"
+VOID = {"meta", "img", "br", "hr", "link", "input", "source", "wbr", "col", "area", "base"}
+
+
+class Page(HTMLParser):
+    """Checks nesting as it parses; collects headings, images, warning boxes, details."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.stack: list[str] = []
+        self.errors: list[str] = []
+        self.headings: list[str] = []  # h1/h2/summary texts, in order
+        self.images: list[str] = []
+        self.events: list[tuple[str, str]] = []  # ("heading"|"warn"|"img"|"details", text)
+        self.metas: list[dict[str, str | None]] = []
+        self.num_cells = 0
+        self._text_of: str | None = None
+        self._buf = ""
+        self.doctype = False
+
+    def handle_decl(self, decl: str) -> None:
+        self.doctype = self.doctype or decl.lower() == "doctype html"
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if tag == "meta":
+            self.metas.append(a)
+        if tag == "img":
+            self.images.append(a.get("src") or "")
+            self.events.append(("img", a.get("src") or ""))
+        if tag == "div" and a.get("class") == "warn":
+            self.events.append(("warn", ""))
+        if tag == "details":
+            self.events.append(("details", ""))
+        if tag == "td" and a.get("class") == "num":
+            self.num_cells += 1
+        if tag in ("h1", "h2", "summary"):
+            self._text_of, self._buf = tag, ""
+        if tag not in VOID:
+            self.stack.append(tag)
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in VOID:
+            return
+        if not self.stack or self.stack[-1] != tag:
+            self.errors.append(f"</{tag}> closes <{self.stack[-1] if self.stack else None}>")
+            return
+        self.stack.pop()
+        if tag == self._text_of:
+            self.headings.append(self._buf.strip())
+            self.events.append(("heading", self._buf.strip()))
+            self._text_of = None
+
+    def handle_data(self, data: str) -> None:
+        if self._text_of:
+            self._buf += data
+
+
+def parse(path: Path) -> Page:
+    page = Page()
+    page.feed(path.read_text(encoding="utf-8"))
+    page.close()
+    assert page.doctype, "no <!DOCTYPE html>"
+    assert not page.errors, page.errors[:5]
+    assert page.stack == [], f"unclosed tags {page.stack}"
+    return page
+
+
+def check_images(page: Page, report_dir: Path) -> None:
+    """Every image the page references exists: a PNG data URI, or a PNG file beside it."""
+    assert page.images
+    for src in page.images:
+        if src.startswith("data:image/png;base64,"):
+            data = base64.b64decode(src.split(",", 1)[1], validate=True)
+        else:
+            data = (report_dir / src).read_bytes()
+        assert data[:8] == PNG and len(data) > 1000, src[:60]
+
+
+def heading_index(page: Page, prefix: str) -> int:
+    hits = [i for i, h in enumerate(page.headings) if h.startswith(prefix)]
+    assert hits, f"no heading {prefix!r} in {page.headings}"
+    return hits[0]
+
+
+@pytest.fixture(scope="module")
+def dryer():
+    return ds.load("dryer")
+
+
+@pytest.fixture(scope="module")
+def track_report(dryer, tmp_path_factory):
+    out = tmp_path_factory.mktemp("track")
+    trace = clpc.CLPC(3, 201, 12, sample_time=dryer.dt).run(dryer)
+    files = report.write_track_report(
+        out, trace, title="CLPC track report: dryer", settings={"file": "x.csv", "w": 201},
+        data=dryer, data_note="the whole record",
+    )  # fmt: skip
+    return out, files, trace
+
+
+def test_track_report_parses_and_reads_top_down(track_report):
+    out, files, _ = track_report
+    page = parse(files[-1])
+    assert {"name": "viewport", "content": "width=device-width, initial-scale=1"} in page.metas
+    check_images(page, out)
+    order = [
+        heading_index(page, p)
+        for p in (
+            "CLPC track report",
+            "Result",
+            "Model: steady state",
+            "Measured data, model output and residuals",
+            "Step and frequency response",
+            "Trace",
+            "Settings",
+        )
+    ]
+    assert order == sorted(order), page.headings
+    assert page.headings[-1] == "Settings"  # settings last ...
+    kinds = [k for k, _ in page.events]
+    # ... and folded: the last <details> opens just before the "Settings" summary
+    last_details = len(kinds) - 1 - kinds[::-1].index("details")
+    assert page.events[last_details + 1] == ("heading", "Settings")
+    # the warnings box belongs to the result section, before any figure
+    result = page.events.index(("heading", "Result"))
+    following = [i for i, (k, _) in enumerate(page.events) if k == "heading" and i > result]
+    assert result < kinds.index("warn") < following[0] < kinds.index("img")
+    assert page.num_cells > 5  # numbers sit in no-wrap cells
+
+
+def test_track_report_warns_about_the_flagged_clusters(track_report):
+    _, files, trace = track_report
+    text = files[-1].read_text()
+    box = text.split('<div class="warn"', 1)[1].split("</div>", 1)[0]
+    n = len(trace)
+    determined = int(trace.arrays["determined"].all(axis=1).sum())
+    assert determined < n  # the first windows are not full
+    assert f"{determined} of {n} clusters determine the parameters" in box
+    assert "white-space:nowrap" in text  # CSS of the numeric cells
+
+
+def test_linked_images_exist_beside_the_report(dryer, tmp_path):
+    model = clpc.LPC(order=2).fit(dryer)
+    files = report.write_identify_report(tmp_path / "id", model, dryer, title="identify")
+    page = parse(files[-1])
+    check_images(page, files[-1].parent)
+    assert heading_index(page, "Result") < heading_index(page, "Settings")
+    linked = report.write_html_report(
+        tmp_path / "id" / "linked.html",
+        "linked",
+        [report.Section("figures", images=[f for f in files if f.suffix == ".png"])],
+        embed_images=False,
+    )
+    page = parse(linked)
+    assert not any(s.startswith("data:") for s in page.images)
+    check_images(page, linked.parent)
+
+
+def test_report_without_dt_is_labelled_in_samples(tmp_path):
+    data = ds.load("robot_arm")  # no sample time
+    trace = clpc.CLPC(3, 201, 12).run(data)
+    files = report.write_track_report(tmp_path, trace, data=data)
+    assert "[s]" not in files[-1].read_text()
+    model = clpc.LPC(order=2).fit(data)
+    figures = [
+        plotting.plot_trace(trace),
+        plotting.plot_fit(model, data),
+        plotting.plot_step(model),
+        data.plot(),
+    ]
+    for fig in figures:
+        labels = {a.get_xlabel() for a in fig.axes if a.get_visible() and a.get_xlabel()}
+        assert labels == {"time [samples]"}
+    bode = plotting.plot_bode(model)
+    assert {a.get_xlabel() for a in bode.axes} == {"frequency [cycles/sample]"}
+
+
+@pytest.mark.slow
+def test_report_renders_in_headless_chromium(track_report, tmp_path):
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        pytest.skip("no chromium on PATH: the headless rendering check needs a real browser")
+    _, files, _ = track_report
+    shot = tmp_path / "shot.png"
+    cmd = [
+        browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1000,1400",
+    ]  # fmt: skip
+    dom = subprocess.run(
+        [*cmd, "--dump-dom", files[-1].resolve().as_uri()],
+        capture_output=True, text=True, timeout=120, check=True,
+    ).stdout  # fmt: skip
+    assert "<h2>Result</h2>" in dom and 'class="warn"' in dom and "<summary>Settings" in dom
+    subprocess.run(
+        [*cmd, f"--screenshot={shot}", files[-1].resolve().as_uri()],
+        capture_output=True, timeout=120, check=True,
+    )  # fmt: skip
+    data = shot.read_bytes()
+    assert data[:8] == PNG
+    from matplotlib.image import imread
+
+    pixels = imread(shot)
+    assert pixels.shape[:2] == (1400, 1000)
+    assert np.std(pixels[..., :3]) > 0.05  # not a blank page: text, tables, figures drawn
+
+
+def test_identify_command_writes_a_report(tmp_path):
+    from click.testing import CliRunner
+
+    from clpc.cli import cli
+
+    path = Path(ds.__file__).parent / "daisy_dryer.csv"
+    args = ["identify", str(path), "-u", "u", "-y", "y", "--dt", "0.08", "--order", "auto"]
+    res = CliRunner().invoke(cli, [*args, "--report", str(tmp_path / "rep")])
+    assert res.exit_code == 0, res.output
+    html_file = tmp_path / "rep" / "report.html"
+    assert f"wrote {html_file}" in res.output
+    page = parse(html_file)
+    check_images(page, html_file.parent)
+    order = [heading_index(page, h) for h in ("Result", "Order selection", "Measured", "Settings")]
+    assert order == sorted(order)
+    assert "(chosen)" in html_file.read_text()
