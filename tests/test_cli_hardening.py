@@ -79,8 +79,8 @@ def test_track_sample_time_without_data_sample_time_is_refused(tmp_path, sig):
     u, y = sig
     path = tmp_path / "r.csv"
     write_table(path, ["u", "y"], np.column_stack([u, y]))
-    res = code(2, "track", path, "-u", "u", "-y", "y", "--sample-time", "0.03", "--out", tmp_path)
-    assert "--dt" in res.output and "--sample-time" in res.output
+    res = code(2, "track", path, "-u", "u", "-y", "y", "--decimate-to", "0.03", "--out", tmp_path)
+    assert "--dt" in res.output and "--decimate-to" in res.output
 
 
 def test_track_window_too_small_fails(tmp_path, sig):
@@ -107,7 +107,7 @@ def test_stream_window_too_small_fails():
 
 def test_stream_sample_time_without_dt_is_refused(sig):
     u, y = sig
-    res = code(2, "stream", "--sample-time", "0.03", input=_csv(u, y))
+    res = code(2, "stream", "--decimate-to", "0.03", input=_csv(u, y))
     assert "--dt" in res.output
 
 

@@ -1,9 +1,13 @@
-"""Run the documented commands and paste their real output into docs/cli.md."""
+"""Run the documented commands and paste their real output into docs/cli.md.
+
+Run it with the python whose clpc is documented: ``python docs/tools/gen_cli_md.py``.
+"""
 
 import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -13,7 +17,7 @@ DATA = os.path.dirname(str(d.path("dryer")))
 WORK = Path(tempfile.mkdtemp(prefix="clpc-cli-doc-"))
 shutil.rmtree(WORK, ignore_errors=True)
 WORK.mkdir(parents=True)
-env = dict(os.environ, DATA=DATA, PATH=f"/work/venv/bin:{os.environ['PATH']}")
+env = dict(os.environ, DATA=DATA, PATH=f"{Path(sys.executable).parent}:{os.environ['PATH']}")
 
 
 def sh(cmd: str) -> str:
@@ -28,5 +32,5 @@ def sh(cmd: str) -> str:
 
 template = Path(__file__).with_name("cli.md.in").read_text()
 doc = re.sub(r"@@(.+?)@@", lambda m: sh(m.group(1)), template)
-Path(__file__).parents[1] / "cli.md".write_text(doc)
+(Path(__file__).parents[1] / "cli.md").write_text(doc)
 print(doc)

@@ -4,36 +4,113 @@ The LPC estimator fits a linear difference equation ``A(q) y + B(q) u = r`` to m
 input/output data by total least squares (the eigenvector of the smallest eigenvalue of the
 centered scatter matrix of lag vectors); CLPC runs it window by window as a finite-state
 machine and reports time-varying parameters and the degree of linearity of each cluster.
+
+``import clpc`` is cheap: every exported name is imported from its module on first use
+(module-level ``__getattr__``), so a script that needs only :class:`LPC` never pays for
+scipy.stats or the CLPC engine.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 from clpc import _moved
 from clpc._version import __version__
-from clpc.analysis.metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
-from clpc.analysis.operating_point import operating_point_diagnostics
-from clpc.appraiser import CLPC, Convergence, Trace
-from clpc.data import DataError, IOData, as_iodata
-from clpc.io import load_iodata, load_model, read_table, save_model, write_table
-from clpc.lpc import (
-    ARX,
-    LPC,
-    OE,
-    DelaySelection,
-    Identification,
-    NoiseEstimate,
-    OrderSelection,
-    RobustRule,
-    estimate_noise_variances,
-    identify,
-    lpc_solve,
-    select_delay,
-    select_order,
-    simulate_arx,
-)
-from clpc.model import LinearModel, ModelError, Structure, Verdict, describe_trace, fit_verdict
-from clpc.model.residuals import ResidualAnalysis, residual_analysis
-from clpc.multimodel import MultiModel
+
+if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on first use
+    from clpc.analysis.metrics import fit_percent, kstep_fit, rmse, vaf, whiteness_test
+    from clpc.analysis.operating_point import operating_point_diagnostics
+    from clpc.appraiser import CLPC, Convergence, Trace
+    from clpc.data import DataError, IOData, as_iodata
+    from clpc.io import load_iodata, load_model, read_table, save_model, write_table
+    from clpc.lpc import (
+        ARX,
+        LPC,
+        OE,
+        DelaySelection,
+        Identification,
+        NoiseEstimate,
+        OrderSelection,
+        RobustRule,
+        estimate_noise_variances,
+        identify,
+        lpc_solve,
+        select_delay,
+        select_order,
+        simulate_arx,
+    )
+    from clpc.model import (
+        LinearModel,
+        ModelError,
+        Structure,
+        Verdict,
+        describe_trace,
+        fit_verdict,
+    )
+    from clpc.model.residuals import ResidualAnalysis, residual_analysis
+    from clpc.multimodel import MultiModel
 
 _moved.install()
+
+#: exported name -> the module that defines it (imported on first access)
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(
+        ("fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"), "clpc.analysis.metrics"
+    ),
+    "operating_point_diagnostics": "clpc.analysis.operating_point",
+    **dict.fromkeys(("CLPC", "Convergence", "Trace"), "clpc.appraiser"),
+    **dict.fromkeys(("DataError", "IOData", "as_iodata"), "clpc.data"),
+    **dict.fromkeys(
+        ("load_iodata", "load_model", "read_table", "save_model", "write_table"), "clpc.io"
+    ),
+    **dict.fromkeys(
+        (
+            "ARX",
+            "LPC",
+            "OE",
+            "DelaySelection",
+            "Identification",
+            "NoiseEstimate",
+            "OrderSelection",
+            "RobustRule",
+            "estimate_noise_variances",
+            "identify",
+            "lpc_solve",
+            "select_delay",
+            "select_order",
+            "simulate_arx",
+        ),
+        "clpc.lpc",
+    ),
+    **dict.fromkeys(
+        ("LinearModel", "ModelError", "Structure", "Verdict", "describe_trace", "fit_verdict"),
+        "clpc.model",
+    ),
+    **dict.fromkeys(("ResidualAnalysis", "residual_analysis"), "clpc.model.residuals"),
+    "MultiModel": "clpc.multimodel",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import an exported name (or a subpackage such as ``clpc.lpc``) on first access."""
+    module = _LAZY.get(name)
+    if module is not None:
+        value = getattr(importlib.import_module(module), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    if not name.startswith("__"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module 'clpc' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
 
 __all__ = [
     "ARX",

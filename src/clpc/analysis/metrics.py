@@ -6,9 +6,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
-
-from clpc.model.residuals import ljung_box
 
 __all__ = ["fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"]
 
@@ -137,5 +134,11 @@ def whiteness_test(residuals: Any, lags: int = 20) -> WhitenessResult:
     n = e.size
     spec = np.fft.rfft(e, 2 * n)
     acf = np.fft.irfft(spec * np.conj(spec))[: lags + 1] / denom
+    # clpc.model loads scipy.signal and with it scipy.stats (~0.5 s): only where it is used
+    from scipy import stats
+
+    from clpc.model.residuals import ljung_box
+
     q = ljung_box(acf[1:], n)
+
     return WhitenessResult(float(q), float(stats.chi2.sf(q, lags)), lags, acf[1:])

@@ -34,8 +34,9 @@ def decimation_factor(target: float | None, data_dt: float | None) -> int:
     factor = round(ratio)
     if factor < 1 or abs(ratio - factor) > FACTOR_RTOL * max(ratio, 1.0):
         raise DataError(
-            f"sample_time={target:g} s must be an integer multiple of the data's sample "
-            f"time {data_dt:g} s (ratio {ratio:g}); resample the data or choose sample_time "
+            f"decimate_to={target:g} s (the rate the appraiser works at; former name "
+            f"sample_time) must be an integer multiple of the data's sample time dt = "
+            f"{data_dt:g} s (ratio {ratio:g}); resample the data or choose decimate_to "
             "accordingly."
         )
     return factor

@@ -2,7 +2,7 @@
 
 Semantics (``docs/clpc.md`` says the same):
 
-* Samples are numbered ``k = 0, 1, 2, ...`` (after decimation to ``sample_time``). The lag
+* Samples are numbered ``k = 0, 1, 2, ...`` (after decimation to ``decimate_to``). The lag
   vector ``z_k`` exists once ``k >= max_lag`` (``max_lag = N`` for the paper's structure).
 * ``window_size`` ``W`` is the number of lag vectors (rows of M, eq. 36) in one LPC.
   The counter counts lag vectors; each time it reaches ``cluster_size`` ``C`` (the
@@ -18,9 +18,11 @@ Semantics (``docs/clpc.md`` says the same):
   above its quantization, a solution the data determine (see :mod:`clpc.core.rules`). An
   update that is not accepted holds the last accepted parameters; parameters are never NaN
   (zeros, with ``has_model=False``, until a first estimate is accepted).
-* ``sample_time``: data sampled faster by an integer factor are low-pass filtered (causal
-  4th-order Butterworth at 0.8 of the new Nyquist frequency, filter state carried across
-  chunks) and every factor-th sample is kept (samples ``0, f, 2f, ...``).
+* ``decimate_to``: data sampled (``dt``) faster by an integer factor are low-pass filtered
+  (causal 4th-order Butterworth at 0.8 of the new Nyquist frequency, filter state carried
+  across chunks) and every factor-th sample is kept (samples ``0, f, 2f, ...``). The former
+  ``sample_time`` named either ``dt`` or ``decimate_to`` depending on the data; it still works
+  and warns (``DeprecationWarning``) whenever it had to pick.
 
 The state (the last window of samples, the counter, the last parameters, the filter state) is
 the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` serialise it.
@@ -28,7 +30,10 @@ the paper's FSM state; :meth:`CLPC.state_dict` / :meth:`CLPC.from_state_dict` se
 
 from __future__ import annotations
 
+import logging
 import math
+import warnings
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -43,7 +48,14 @@ from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite, check_
 from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup, TraceLabels
-from clpc.core.checks import check_bool, check_choice, check_int, check_positive
+from clpc.core.checks import (
+    check_bool,
+    check_choice,
+    check_int,
+    check_positive,
+    resolve_order,
+    same_setting,
+)
 from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError, IOData, as_iodata
 from clpc.data.samples import check_spread
@@ -51,21 +63,36 @@ from clpc.model.structure import Structure
 
 __all__ = ["CLPC"]
 
+_LOG = logging.getLogger("clpc.appraiser")
+
 
 class CLPC:
     """The Cluster LPC appraiser: streaming ``step``/``push`` and a vectorised ``run``.
 
     Parameters
     ----------
-    parameters_size : int
-        Size of ``a`` and ``b`` (``N + 1``); the paper's Table 1 uses 3 (``N = 2``).
+    parameters_size : int, optional
+        The paper's name: size of ``a`` and of ``b``, ``N + 1`` (an alias of ``order``;
+        Table 1 uses 3). Kept as the first positional argument: ``CLPC(3, 201, 12)``.
     window_size : int
         ``W``: lag vectors per LPC (Table 1: 201).
     cluster_size : int
         ``C``: lag vectors between updates (Table 1: 12). The paper's name
         ``data_cluster_dimension`` is accepted too.
     sample_time : float, optional
-        Sample time [s] the appraiser works at (Table 1: 0.01). Default: the data's.
+        Former name, ambiguous: the data's sample time for plain arrays without ``dt``, a
+        decimation target when the data's ``dt`` is known. Still works as before, with a
+        ``DeprecationWarning`` whenever one meaning was picked; pass ``dt`` or
+        ``decimate_to`` instead.
+    order : int, optional
+        The model order ``N`` (``na = nb = N``); default 2 (the paper's Table 1).
+    dt : float, optional
+        Sample time of the data [s] given to :meth:`step`/:meth:`push`/:meth:`run` as plain
+        arrays (a record's own ``dt`` is used by :meth:`run`; the two must agree).
+    decimate_to : float, optional
+        Sample time [s] the appraiser works at, an integer multiple of the data's: the
+        data are low-pass filtered and decimated (Table 1: 0.01 on 1 ms data). Needs the
+        data's sample time (``dt``, or a record with ``dt``).
     data_cluster_dimension : int, optional
         Alias of ``cluster_size``.
     na, nb, nk : int, optional
@@ -86,8 +113,7 @@ class CLPC:
     min_rows : int, optional
         Fewest rows for a usable estimate (default ``2 p``); smaller windows are not solved.
     data_sample_time : float, optional
-        Sample time of the data given to :meth:`step`/:meth:`push` [s] (default
-        ``sample_time``); :meth:`run` takes it from the record.
+        Former name of ``dt``.
     n_jobs : int
         Threads for the batched solves (windows are independent).
     chunk_samples : int
@@ -101,11 +127,14 @@ class CLPC:
 
     def __init__(
         self,
-        parameters_size: int = 3,
+        parameters_size: int | None = None,
         window_size: int = 201,
         cluster_size: int | None = None,
         sample_time: float | None = None,
         *,
+        order: int | None = None,
+        dt: float | None = None,
+        decimate_to: float | None = None,
         data_cluster_dimension: int | None = None,
         na: int | None = None,
         nb: int | None = None,
@@ -132,10 +161,11 @@ class CLPC:
                     f"{cluster_size} and {data_cluster_dimension}. Pass one of them."
                 )
         cluster = cluster_size if cluster_size is not None else data_cluster_dimension
-        self.parameters_size = check_int(parameters_size, "parameters_size", 2)
+        order = resolve_order(order, parameters_size)
+        self.order = order
+        self.parameters_size = order + 1
         self.window_size = check_int(window_size, "window_size", 2)
         self.cluster_size = check_int(12 if cluster is None else cluster, "cluster_size", 1)
-        order = self.parameters_size - 1
         self.structure = Structure(order if na is None else na, order if nb is None else nb, nk)
         self._max_lag = self.structure.max_lag  # read on every step()
         self.method = check_choice(method, "method", ("robust", "paper"))
@@ -156,10 +186,20 @@ class CLPC:
         )
         self.min_rows = None if min_rows is None else check_int(min_rows, "min_rows", 2, top)
         fsm.check_window(self, self.structure.n_params())  # one input: the fewest parameters
-        self.sample_time = None if sample_time is None else _seconds(sample_time, "sample_time")
-        self.data_sample_time = (
-            None if data_sample_time is None else _seconds(data_sample_time, "data_sample_time")
-        )
+        if sample_time is not None and decimate_to is not None:
+            raise ValueError(
+                f"sample_time is the former, ambiguous name of decimate_to; got "
+                f"sample_time={sample_time!r} and decimate_to={decimate_to!r}. Pass "
+                "decimate_to (the rate to work at) and dt (the data's sample time)."
+            )
+        target = decimate_to if decimate_to is not None else sample_time
+        #: the sample time the appraiser works at (internal name; see decimate_to)
+        target_name = "sample_time" if decimate_to is None else "decimate_to"
+        self.sample_time = None if target is None else _seconds(target, target_name)
+        #: sample_time was given: its meaning is picked from the data (with a warning)
+        self._legacy_sample_time = sample_time is not None
+        data_dt = same_setting(dt, data_sample_time, "dt", "data_sample_time")
+        self.data_sample_time = None if data_dt is None else _seconds(data_dt, "dt")
         self.n_jobs = check_int(n_jobs, "n_jobs", 1)
         self.chunk_samples = check_int(chunk_samples, "chunk_samples", 1024)
         self._engine_request = engine
@@ -185,6 +225,16 @@ class CLPC:
         self._trace_labels: TraceLabels | None = None
         self._empty: Trace | None = None
         return self
+
+    @property
+    def decimate_to(self) -> float | None:
+        """Sample time [s] the appraiser works at (``None``: the data's)."""
+        return self.sample_time
+
+    @property
+    def dt(self) -> float | None:
+        """The data's sample time [s] given to the constructor (``None``: from the data)."""
+        return self.data_sample_time
 
     @property
     def gate(self) -> bool:
@@ -264,13 +314,19 @@ class CLPC:
         self._n_seen -= block.shape[0]  # _consume counts them
         return fsm.consume(self, block)
 
-    def push(self, u: Any, y: Any) -> Trace:
+    def push(
+        self, u: Any, y: Any, *, progress: Callable[[int, int, int], Any] | None = None
+    ) -> Trace:
         """Feed a chunk of samples of any length.
 
         Parameters
         ----------
         u : array_like, shape (n,) or (n, n_inputs)
         y : array_like, shape (n,) or (n, n_outputs)
+        progress : callable, optional
+            Called as ``progress(samples_done, samples_total, updates_done)`` after each
+            block of ``chunk_samples`` samples; the same is logged at ``DEBUG`` level on
+            the ``clpc.appraiser`` logger.
 
         Returns
         -------
@@ -299,12 +355,39 @@ class CLPC:
             part = fsm.consume(self, self._decimator(np.hstack([u2[lo:hi], y2[lo:hi]])))
             if total:
                 done = out.put(done, part)
+            finished = min(hi, u2.shape[0])
+            _LOG.debug("CLPC: %d of %d samples, %d updates", finished, u2.shape[0], done)
+            if progress is not None:
+                progress(finished, u2.shape[0], done)
         assert done == total, (done, total)
         return out
 
     def _factor_for(self, data_dt: float | None) -> int:
-        dt = data_dt if data_dt is not None else (self.data_sample_time or self.sample_time)
-        return decimation_factor(self.sample_time, dt)
+        dt = data_dt if data_dt is not None else self.data_sample_time
+        target = self.sample_time
+        if dt is None and target is not None:
+            if not self._legacy_sample_time:
+                raise DataError(
+                    f"decimate_to={target:g} s needs the data's sample time; pass dt= to CLPC "
+                    "(or to run()), or give an IOData with its dt."
+                )
+            warnings.warn(
+                f"CLPC(sample_time={target:g}) was taken as the data's sample time (the data "
+                f"came without one); pass dt={target:g} instead (sample_time is ambiguous).",
+                DeprecationWarning,
+                stacklevel=4,
+            )
+            dt = target
+        elif self._legacy_sample_time and target is not None and dt is not None:
+            if not math.isclose(target, dt, rel_tol=1e-9):
+                warnings.warn(
+                    f"CLPC(sample_time={target:g}) was taken as the decimation target (the "
+                    f"data's sample time is {dt:g} s); pass decimate_to={target:g} instead "
+                    "(sample_time is ambiguous).",
+                    DeprecationWarning,
+                    stacklevel=4,
+                )
+        return decimation_factor(target, dt)
 
     def _updates_after(self, n_samples: int) -> int:
         """Updates that ``n_samples`` more (undecimated) samples will complete."""
@@ -315,7 +398,14 @@ class CLPC:
         rows = max(self._n_seen + kept - self.structure.max_lag, 0)
         return rows // self.cluster_size - self._j_done
 
-    def run(self, u: Any, y: Any | None = None, dt: float | None = None) -> Trace:
+    def run(
+        self,
+        u: Any,
+        y: Any | None = None,
+        dt: float | None = None,
+        *,
+        progress: Callable[[int, int, int], Any] | None = None,
+    ) -> Trace:
         """Reset, then process a whole record (vectorised over windows).
 
         Parameters
@@ -323,7 +413,12 @@ class CLPC:
         u : IOData or array_like, shape (T,) or (T, n_inputs)
         y : array_like, shape (T,) or (T, n_outputs), optional
         dt : float, optional
-            Sample time of the record [s] (default: the record's, else ``sample_time``).
+            Sample time of the record [s] (default: the record's, else the constructor's
+            ``dt``).
+        progress : callable, optional
+            ``progress(samples_done, samples_total, updates_done)`` after each block of
+            ``chunk_samples`` samples (see :meth:`push`; also logged at ``DEBUG`` level on
+            the ``clpc.appraiser`` logger).
 
         Returns
         -------
@@ -339,17 +434,29 @@ class CLPC:
             fsm.init_channels(self, u_arr.shape[1], y_arr.shape[1])
         else:
             data = as_iodata(u, y, dt)
+            if data.n_experiments > 1:
+                raise DataError(
+                    f"CLPC runs over one continuous record; this one holds "
+                    f"{data.n_experiments} experiments, and its windows would reach across "
+                    "their boundaries. Run each experiment on its own (IOData.split())."
+                )
             u_arr, y_arr = data.u, data.y
             given_dt = isinstance(u, IOData) or dt is not None
             data_dt = data.dt if given_dt else None  # arrays without dt: at sample_time
             names = (data.input_names, data.output_names)
             fsm.init_channels(self, data.n_inputs, data.n_outputs, names)
+        own = self.data_sample_time
+        if data_dt is not None and own is not None and not math.isclose(data_dt, own, rel_tol=1e-9):
+            raise DataError(
+                f"the record's sample time is {data_dt:g} s but CLPC(dt={own:g}); they must "
+                "agree (dt is the data's sample time; decimate_to is the rate to work at)."
+            )
         if self.noise_cov is None and self.noise_ratio is None:
             check_spread(u_arr, y_arr, self.scaling)
         self._decimator = Decimator(self._factor_for(data_dt))
         if self.sample_time is None and data_dt is not None:
             self._record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        trace = self.push(u_arr, y_arr)
+        trace = self.push(u_arr, y_arr, progress=progress)
         factor = self._decimator.factor if self._decimator is not None else 1
         attach_levels(trace, y_arr, factor)  # the windows' levels, for steady_state_model
         return trace
@@ -385,8 +492,9 @@ class CLPC:
 
     def __repr__(self) -> str:
         return (
-            f"CLPC(parameters_size={self.parameters_size}, window_size={self.window_size}, "
-            f"cluster_size={self.cluster_size}, sample_time={self.sample_time}, "
+            f"CLPC(order={self.order}, window_size={self.window_size}, "
+            f"cluster_size={self.cluster_size}, dt={self.data_sample_time}, "
+            f"decimate_to={self.sample_time}, "
             f"method={self.method!r}, scaling={self.scaling!r}, "
             f"samples_seen={self._n_seen}, updates={self._j_done})"
         )

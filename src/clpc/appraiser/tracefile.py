@@ -8,6 +8,7 @@ for figures and summaries (every update until the cap, then every 2nd, 4th, ... 
 
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -17,16 +18,18 @@ import numpy as np
 from clpc.appraiser.trace import SCALAR_KEYS, Trace
 from clpc.data import DataError
 
-__all__ = ["ThinnedTrace", "TraceWriter", "trace_columns"]
+__all__ = ["ThinnedTrace", "TraceWriter", "trace_column_list", "trace_columns"]
 
 
-def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
-    """A trace as a numeric table: column names and a float array (one row per update).
+def trace_column_list(trace: Trace) -> tuple[list[str], list[np.ndarray]]:
+    """A trace's columns, each in its own type (see :func:`trace_columns` for the layout).
 
-    Columns: ``index``, ``time``, ``rows``, ``not_enough_data``, then per output (prefixed
-    ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
-    the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
-    flags are 0/1.
+    Returns
+    -------
+    names : list of str
+    columns : list of ndarray, shape (n_updates,)
+        ``int64`` for counts and flags (``index``, ``rows``, ``n_null``, ``accepted``, ...),
+        ``float64`` for everything else.
     """
     names = ["index", "time", "rows", "not_enough_data"]
     cols = [trace.index, trace.time, trace.rows, trace.not_enough_data]
@@ -49,21 +52,58 @@ def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
         for key in SCALAR_KEYS:
             names.append(pre + key)
             cols.append(a[key][:, e])
+    typed = [
+        np.asarray(c, dtype=np.int64 if _is_integer(c) else np.float64)
+        for c in map(np.asarray, cols)
+    ]
+    return names, typed
+
+
+def _is_integer(col: np.ndarray) -> bool:
+    return bool(np.issubdtype(col.dtype, np.integer) or np.issubdtype(col.dtype, np.bool_))
+
+
+def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
+    """A trace as a numeric table: column names and a float array (one row per update).
+
+    Columns: ``index``, ``time``, ``rows``, ``not_enough_data``, then per output (prefixed
+    ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
+    the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
+    flags are 0/1.
+    """
+    names, cols = trace_column_list(trace)
     table = (
-        np.column_stack([np.asarray(c, dtype=np.float64) for c in cols])
+        np.column_stack([c.astype(np.float64) for c in cols])
         if len(trace)
-        else (np.zeros((0, len(names))))
+        else np.zeros((0, len(names)))
     )
     return names, table
+
+
+def _arrow() -> Any:
+    """Pyarrow (with its csv module), or None when it is missing or ``CLPC_FAST_IO=0``."""
+    if os.environ.get("CLPC_FAST_IO", "1") == "0":
+        return None
+    try:
+        import pyarrow as pa
+        import pyarrow.csv
+    except ImportError:
+        return None
+    return pa
 
 
 class TraceWriter:
     """Append trace parts to a CSV or Parquet file (``trace_columns`` layout).
 
+    Counts and flags are written as integers, other numbers in their shortest exact form
+    (the readers return exactly the values of :func:`trace_columns`). CSV rows are written
+    by pyarrow's CSV writer when pyarrow is installed (a C++ loop), else by one ``%``
+    format per row.
+
     Parameters
     ----------
     path : str or Path
-        ``.csv`` (floats in their shortest exact form) or ``.parquet`` (needs pyarrow).
+        ``.csv`` or ``.parquet`` (needs pyarrow).
     """
 
     def __init__(self, path: str | Path) -> None:
@@ -74,41 +114,58 @@ class TraceWriter:
         self._fh: Any = None
         self._writer: Any = None
         self._names: list[str] | None = None
+        self._row_format = ""
+        self._pa: Any = None
         self.rows = 0
 
     def write(self, part: Trace) -> None:
         """Append the rows of ``part`` (a trace of consecutive updates)."""
         if not len(part):
             return
-        names, table = trace_columns(part)
+        names, cols = trace_column_list(part)
         if self._names is None:
             self._names = names
-            self._open(names)
-        if self.suffix == ".csv":
-            lines = "\n".join(",".join(map(repr, row)) for row in table.tolist())
-            self._fh.write(lines + "\n")
+            self._open(names, cols)
+        if self.suffix == ".parquet":
+            pa = self._pa
+            self._writer.write_table(pa.table(dict(zip(names, cols, strict=True))))
+        elif self._pa is not None:
+            pa = self._pa
+            table = pa.table({f"c{i}": c for i, c in enumerate(cols)})
+            pa.csv.write_csv(table, self._fh, pa.csv.WriteOptions(include_header=False))
         else:
-            import pyarrow as pa
+            rows = np.column_stack([c.astype(object) for c in cols]).tolist()
+            fmt = self._row_format
+            self._fh.write("".join([fmt % tuple(r) for r in rows]))
+        self.rows += len(part)
 
-            batch = pa.table({n: table[:, i] for i, n in enumerate(names)})
-            self._writer.write_table(batch)
-        self.rows += table.shape[0]
-
-    def _open(self, names: list[str]) -> None:
+    def _open(self, names: list[str], cols: list[np.ndarray]) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        header = (",".join(names) + "\n").encode()
         if self.suffix == ".csv":
-            self._fh = self.path.open("w", encoding="utf-8")
-            self._fh.write(",".join(names) + "\n")
-        else:
-            try:
-                import pyarrow as pa
-                import pyarrow.parquet as pq
-            except ImportError:
-                raise ImportError(
-                    "Parquet traces need pyarrow: pip install 'clpc[frames]'"
-                ) from None
-            schema = pa.schema([(n, pa.float64()) for n in names])
-            self._writer = pq.ParquetWriter(self.path, schema)
+            self._pa = _arrow()
+            if self._pa is not None:
+                self._fh = self.path.open("wb")
+                self._fh.write(header)
+            else:
+                self._fh = self.path.open("w", encoding="utf-8")
+                self._fh.write(header.decode())
+                formats = ["%d" if _is_integer(c) else "%r" for c in cols]
+                self._row_format = ",".join(formats) + "\n"
+            return
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError:
+            raise ImportError("Parquet traces need pyarrow: pip install 'clpc[frames]'") from None
+        self._pa = pa
+        schema = pa.schema(
+            [
+                (n, pa.int64() if _is_integer(c) else pa.float64())
+                for n, c in zip(names, cols, strict=True)
+            ]
+        )
+        self._writer = pq.ParquetWriter(self.path, schema)
 
     def close(self) -> None:
         """Flush and close the file."""

@@ -13,14 +13,18 @@ from typing import Any
 
 import click
 
-from clpc.data import DataError
-from clpc.model import ModelError
-from clpc.workflows import ChannelCountError, SamplingConflictError, SettingsError
+__all__ = ["ClpcCommand", "ClpcGroup", "one_line", "user_errors"]
 
-__all__ = ["ClpcCommand", "ClpcGroup", "one_line"]
 
-#: library errors reported as one line with exit code 1
-USER_ERRORS = (DataError, ModelError, OSError, ValueError, ImportError)
+def user_errors() -> tuple[type[BaseException], ...]:
+    """Library errors reported as one line with exit code 1.
+
+    Imported here, when a command runs, so that ``clpc --help`` never imports the library.
+    """
+    from clpc.data import DataError
+    from clpc.model import ModelError
+
+    return (DataError, ModelError, OSError, ValueError, ImportError)
 
 
 def one_line(exc: BaseException) -> str:
@@ -38,8 +42,10 @@ def _silence_stdout() -> None:
         pass
 
 
-def usage_message(exc: SettingsError) -> str:
+def usage_message(exc: Exception) -> str:
     """A workflow's settings error in the words of the command line's options."""
+    from clpc.workflows.common import ChannelCountError, SamplingConflictError
+
     if isinstance(exc, ChannelCountError):
         return (
             f"the model has {len(exc.model_names)} {exc.kind}(s) {exc.model_names}; "
@@ -55,6 +61,8 @@ class ClpcCommand(click.Command):
 
     def invoke(self, ctx: click.Context) -> Any:
         """Run the command; a :class:`SettingsError` becomes a :class:`click.UsageError`."""
+        from clpc.workflows.common import SettingsError
+
         try:
             return super().invoke(ctx)
         except SettingsError as exc:
@@ -73,5 +81,5 @@ class ClpcGroup(click.Group):
         except BrokenPipeError:  # the reader went away (e.g. `clpc simulate ... | head`)
             _silence_stdout()
             ctx.exit(1)
-        except USER_ERRORS as exc:  # DataError, ModelError, FileNotFoundError, ValueError
+        except user_errors() as exc:  # DataError, ModelError, FileNotFoundError, ValueError
             raise click.ClickException(one_line(exc)) from None

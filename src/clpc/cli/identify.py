@@ -117,12 +117,26 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     "rejected (validation); BIC, AIC or the paper's Remark 1.",
 )
 @click.option(
+    "--na",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Output order (A has na + 1 coefficients); overrides --order for A.",
+)
+@click.option(
+    "--nb",
+    type=click.IntRange(min=0),
+    default=None,
+    help="Input order (each B has nb + 1 coefficients: MATLAB's arx nb is this + 1); "
+    "overrides --order for B.",
+)
+@click.option(
     "--nk",
     type=DelayType(),
     default="0",
     show_default=True,
-    help="Input delay in samples, or 'auto' (0..4 compared on held-out data; implies "
-    "--estimator lpc unless --estimator is given).",
+    help="Input delay in samples (0: b0 acts at once, as in the paper; a physical plant with "
+    "no direct feed-through has nk >= 1, as MATLAB's default), or 'auto' (0..4 compared on "
+    "held-out data; implies --estimator lpc unless --estimator is given).",
 )
 @click.option(
     "--estimator",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import click
@@ -89,7 +90,11 @@ def demo(
     Example:
       clpc demo --out demo/ --quick
     """  # noqa: D301
-    result = run_demo(out_dir, duration=duration, quick=quick, seed=seed, method=method)
+    with warnings.catch_warnings(record=True) as caught:  # one plain line each, no source
+        warnings.simplefilter("always", UserWarning)
+        result = run_demo(out_dir, duration=duration, quick=quick, seed=seed, method=method)
+    for w in caught:
+        click.echo(f"clpc demo: warning: {w.message}", err=True)
     summary = result.summary
     if as_json:
         echo_json(summary, default=str)

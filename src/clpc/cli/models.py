@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from clpc.cli.errors import ClpcCommand
@@ -36,7 +38,16 @@ __all__ = ["compare", "simulate"]
     default=None,
     help="Write the simulation here (csv, tsv, parquet, npy, npz); default stdout.",
 )
-def simulate(model_file: str, file: str, inputs: tuple[str, ...], out: str | None) -> None:
+@click.option(
+    "--time",
+    "time_col",
+    metavar="COL",
+    default=None,
+    help="A time column to keep (written first, unchanged).",
+)
+def simulate(
+    model_file: str, file: str, inputs: tuple[str, ...], out: str | None, time_col: str | None
+) -> None:
     """Simulate a saved model on the input columns of FILE (free run, zero initial state).
 
     Writes the input columns and one simulated column per output (named OUTPUT_sim).
@@ -45,8 +56,9 @@ def simulate(model_file: str, file: str, inputs: tuple[str, ...], out: str | Non
     Examples:
       clpc simulate model.json new_inputs.csv --input u --out sim.csv
       clpc simulate model.json new_inputs.csv > sim.csv
+      clpc simulate model.json log.csv --input u --time t > sim.csv
     """  # noqa: D301
-    result = simulate_file(model_file, file, inputs, out)
+    result = simulate_file(model_file, file, inputs, out, time_col)
     if out:
         click.echo(f"wrote {out} ({result.values.shape[0]} rows)", err=True)
     else:
@@ -82,7 +94,9 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
     """Compare a saved model with measured data: fit % of simulation or k-step prediction.
 
     The first max-lag samples give the initial conditions; the fit % (100 = perfect,
-    0 = as good as the mean) is computed over the rest.
+    0 = as good as the mean) is computed over the rest. Data whose --dt or --time says
+    they are sampled at another rate than the model's are refused; a response that diverges
+    exits 1.
 
     \b
     Examples:
@@ -90,8 +104,10 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
       clpc compare model.json validation.csv -u uVal -y yVal --k 10 --plot cmp.png
     """  # noqa: D301
     result = compare_file(settings)
+    diverged = [name for name, fit in result.fit.items() if fit is None]
     if as_json:
         echo_json(result.to_dict())
+        _exit_if_diverged(diverged, result.compared)
         return
     last = result.n_samples - 1
     for name, fit in result.fit.items():
@@ -101,3 +117,15 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
         )
     if result.plot:
         click.echo(f"wrote {result.plot}")
+    _exit_if_diverged(diverged, result.compared)
+
+
+def _exit_if_diverged(names: list[str], compared: str) -> None:
+    """A comparison whose response diverges failed: say so and exit 1."""
+    if names:
+        click.echo(
+            f"Error: the model's {compared} diverges on this record (output(s) {names}): "
+            "there is no fit to report.",
+            err=True,
+        )
+        sys.exit(1)

@@ -73,6 +73,10 @@ def multimodel(
     outputs: tuple[str, ...],
     dt: float | None,
     time_col: str | None,
+    time_unit: str | None,
+    time_rtol: float,
+    resample: bool,
+    skip_rows: int,
     order: int,
     n_models: int | None,
     max_models: int,
@@ -87,7 +91,17 @@ def multimodel(
     Example:
       clpc multimodel run.csv -u command -y position --dt 0.01 --save mm.json --figure mm.png
     """  # noqa: D301
-    record = RecordSpec(file, tuple(inputs), tuple(outputs), dt, time_col)
+    record = RecordSpec(
+        file,
+        tuple(inputs),
+        tuple(outputs),
+        dt,
+        time_col,
+        time_unit=time_unit,
+        time_rtol=time_rtol,
+        resample=resample,
+        skip_rows=skip_rows,
+    )
     settings = MultiModelSettings(record, order, n_models, max_models, schedule, save, figure)
     summary = multimodel_file(settings)
     if as_json:

@@ -13,6 +13,7 @@ from typing import Any
 
 import click
 
+from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
 from clpc.workflows import AppraiserSettings, RecordSpec
 
 __all__ = [
@@ -35,6 +36,7 @@ __all__ = [
     "record_settings",
     "sampling_options",
     "save_option",
+    "stream_sampling_options",
 ]
 
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
@@ -134,8 +136,8 @@ def dt_option() -> Decorator:
     )
 
 
-def sampling_options() -> Decorator:
-    """``--dt`` and ``--time COL`` (into ``time_col``)."""
+def stream_sampling_options() -> Decorator:
+    """``--dt`` and ``--time COL`` (into ``time_col``): the sampling of standard input."""
     return combine(
         dt_option(),
         click.option(
@@ -144,6 +146,51 @@ def sampling_options() -> Decorator:
             metavar="COL",
             default=None,
             help="Column of sample times [s]; must be uniformly spaced.",
+        ),
+    )
+
+
+def sampling_options() -> Decorator:
+    """The sampling options of a record read from a file.
+
+    ``--dt``, ``--time COL`` (into ``time_col``), ``--time-unit``, ``--time-rtol``,
+    ``--resample`` and ``--skip-rows``.
+    """
+    return combine(
+        dt_option(),
+        click.option(
+            "--time",
+            "time_col",
+            metavar="COL",
+            default=None,
+            help="Column of sample times; dt is its mean step (steps uniform within --time-rtol).",
+        ),
+        click.option(
+            "--time-unit",
+            type=click.Choice(list(TIME_UNITS)),
+            default=None,
+            help="Unit of the --time column (default: from its name, e.g. t_ms is ms; else s).",
+        ),
+        click.option(
+            "--time-rtol",
+            type=click.FloatRange(min=0, min_open=True),
+            default=DEFAULT_TIME_RTOL,
+            show_default=True,
+            help="Largest relative deviation of one time step from the median step.",
+        ),
+        click.option(
+            "--resample",
+            is_flag=True,
+            help="Interpolate onto a uniform time grid instead of refusing a jittery --time "
+            "column (not for track).",
+        ),
+        click.option(
+            "--skip-rows",
+            type=click.IntRange(min=0),
+            default=0,
+            show_default=True,
+            help="Lines to skip at the top of a text file (a metadata line); a units row "
+            "under the header (s,m,V) is skipped without it.",
         ),
     )
 
@@ -172,7 +219,8 @@ def nk_option() -> Decorator:
         type=click.IntRange(min=0),
         default=0,
         show_default=True,
-        help="Input delay in samples.",
+        help="Input delay in samples (0: b0 acts at once, as in the paper; a physical plant "
+        "with no direct feed-through has nk >= 1, as MATLAB's default).",
     )
 
 
@@ -180,12 +228,20 @@ def appraiser_options() -> Decorator:
     """The appraiser's options, collected into ``appraiser`` (:class:`AppraiserSettings`)."""
     return combine(
         click.option(
+            "--order",
+            "-n",
+            type=click.IntRange(min=1),
+            default=2,
+            show_default=True,
+            help="Model order N (na = nb = N), as in clpc identify.",
+        ),
+        click.option(
             "--parameters-size",
             "-p",
             type=click.IntRange(min=2),
-            default=3,
-            show_default=True,
-            help="Size of a and of b (N + 1).",
+            default=None,
+            hidden=True,
+            help="The paper's name for N + 1 (former option; use --order).",
         ),
         click.option(
             "--window",
@@ -205,11 +261,18 @@ def appraiser_options() -> Decorator:
         ),
         nk_option(),
         click.option(
+            "--decimate-to",
+            type=click.FloatRange(min=0, min_open=True),
+            default=None,
+            help="Sample time [s] the appraiser works at: an integer multiple of the data's "
+            "--dt (the data are low-pass filtered and decimated).",
+        ),
+        click.option(
             "--sample-time",
             type=click.FloatRange(min=0, min_open=True),
             default=None,
-            help="Sample time [s] the appraiser works at: an integer multiple of the "
-            "data's (the data are low-pass filtered and decimated).",
+            hidden=True,
+            help="Former name of --decimate-to.",
         ),
         method_option(),
         click.option(

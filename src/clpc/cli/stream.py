@@ -16,7 +16,7 @@ from clpc.cli.options import (
     format_option,
     input_option,
     output_option,
-    sampling_options,
+    stream_sampling_options,
 )
 from clpc.workflows import StreamSettings, stream_samples
 
@@ -46,7 +46,7 @@ def _stdin_batches() -> Iterator[list[str]]:
 
 @click.command(cls=ClpcCommand)
 @appraiser_options()
-@sampling_options()
+@stream_sampling_options()
 @input_option(
     required=False,
     help="Input column: csv name (from a header line) or 0-based index, or JSON key; "

@@ -34,11 +34,24 @@ from clpc.workflows import (
 __all__ = ["track"]
 
 
-def _progress_bar(file: str) -> ChunkFilter:
-    """Chunks passed on under a progress bar on standard error (rows of ``file``)."""
+def _progress_bar(file: str, skip_rows: int = 0) -> ChunkFilter:
+    """Chunks passed on under a progress bar on standard error (rows of ``file``).
+
+    On a terminal: click's bar; into a pipe or a file: one plain line per chunk
+    (``tracking: 200000 of 1000000 rows (20%)``), which a log or ``tail -f`` can show.
+    """
 
     def show(chunks: Iterator[Chunk]) -> Iterator[Chunk]:
-        length = count_data_lines(file) or 0
+        length = count_data_lines(file, skip_rows) or 0
+        if not sys.stderr.isatty():
+            done = 0
+            for names, values in chunks:
+                yield names, values
+                done += values.shape[0]
+                share = f" ({100 * done / length:.0f}%)" if length else ""
+                total = f" of {length}" if length else ""
+                click.echo(f"tracking: {done}{total} rows{share}", err=True)
+            return
         with click.progressbar(length=length, label="tracking", file=sys.stderr) as bar:
             for names, values in chunks:
                 yield names, values
@@ -89,7 +102,8 @@ def _print_result(result: TrackResult) -> None:
 @click.option(
     "--progress/--no-progress",
     default=None,
-    help="Progress bar on standard error (default: only on a terminal).",
+    help="Progress on standard error: a bar on a terminal, one line per chunk into a pipe "
+    "(default: only on a terminal).",
 )
 @save_option("Save the steady-state model.")
 @record_settings()
@@ -99,15 +113,17 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     """Run the CLPC appraiser over a record (read in chunks) and write a trace and a report.
 
     Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
-    OUT/report.html with its figures (trace, fit, data, step, bode, pz .png).
+    OUT/report.html with its figures (trace, fit, data, step, bode, pz .png). Exits 1 when
+    --save was asked for and no update was accepted (there is no model to save).
 
     \b
     Examples:
       clpc track servo.csv -u torque -y position --time t --out run1/
-      clpc track big.parquet -u u -y y --dt 0.001 --sample-time 0.01 --out run2/ --progress
+      clpc track big.parquet -u u -y y --dt 0.001 --decimate-to 0.01 --out run2/ --progress
     """  # noqa: D301
     show = progress if progress is not None else sys.stderr.isatty()
-    result = track_file(settings, _progress_bar(settings.record.file) if show else None)
+    bar = _progress_bar(settings.record.file, settings.record.skip_rows) if show else None
+    result = track_file(settings, bar)
     _print_result(result)
     if settings.save and result.model is None:
         raise click.ClickException(

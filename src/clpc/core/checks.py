@@ -19,6 +19,8 @@ __all__ = [
     "check_nonnegative",
     "check_positive",
     "check_real",
+    "resolve_order",
+    "same_setting",
 ]
 
 
@@ -84,3 +86,52 @@ def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
         listed = ", ".join(repr(c) for c in choices)
         raise ValueError(f"{name} must be one of {listed}; got {value!r}.")
     return value
+
+
+def resolve_order(order: Any, parameters_size: Any, default: int = 2) -> int:
+    """The model order ``N`` from ``order`` or the paper's ``parameters_size`` (``N + 1``).
+
+    Parameters
+    ----------
+    order : int or None
+        ``N`` (``na = nb = N``).
+    parameters_size : int or None
+        The paper's name: the size of ``a`` and of ``b``, ``N + 1`` (an alias).
+    default : int
+        ``N`` when neither is given.
+
+    Returns
+    -------
+    int
+        ``N >= 1``.
+
+    Raises
+    ------
+    ValueError
+        Either is out of range, or both are given and disagree.
+    """
+    if parameters_size is not None:
+        from_size = check_int(parameters_size, "parameters_size", 2) - 1
+        if order is not None and check_int(order, "order", 1) != from_size:
+            raise ValueError(
+                f"order and parameters_size name one setting (parameters_size = order + 1); "
+                f"got order={order} and parameters_size={parameters_size}. Pass one of them."
+            )
+        return from_size
+    return check_int(default if order is None else order, "order", 1)
+
+
+def same_setting(new: Any, old: Any, new_name: str, old_name: str) -> Any:
+    """The one value of a setting known by two names (``new`` preferred, ``old`` an alias).
+
+    Raises
+    ------
+    ValueError
+        Both are given and differ.
+    """
+    if new is not None and old is not None and new != old:
+        raise ValueError(
+            f"{new_name} and {old_name} are the same setting ({old_name} is its former name); "
+            f"got {new_name}={new!r} and {old_name}={old!r}. Pass {new_name} only."
+        )
+    return new if new is not None else old

@@ -20,6 +20,7 @@ import functools
 import hashlib
 import importlib.util
 import os
+import sys
 import types
 from collections.abc import Callable
 from pathlib import Path
@@ -27,7 +28,14 @@ from typing import Any, TypeVar
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-__all__ = ["ENGINES", "compiled", "kernel", "numba_available", "resolve_engine"]
+__all__ = [
+    "COMPILE_NOTICE",
+    "ENGINES",
+    "compiled",
+    "kernel",
+    "numba_available",
+    "resolve_engine",
+]
 
 _MARKED: dict[int, Callable[..., Any]] = {}
 _TWINS: dict[int, Any] = {}
@@ -87,6 +95,7 @@ def compiled(fn: Callable[..., Any]) -> Any:
     import numba
 
     _install_stamp()
+    _install_notice()
     scope = dict(fn.__globals__)
     twin = types.FunctionType(fn.__code__, scope, fn.__name__, fn.__defaults__, fn.__closure__)
     twin.__qualname__ = fn.__qualname__
@@ -125,6 +134,42 @@ def _engine_digest() -> str:
 
 
 _STAMP_INSTALLED = False
+_NOTICE: dict[str, Any] = {"installed": False, "said": False}
+
+#: The line written to standard error when clpc's kernels start compiling (not loading
+#: from numba's cache): the first use in a fresh environment takes 15-20 s.
+COMPILE_NOTICE = (
+    "clpc: compiling the CLPC kernel (first use in this environment, about 20 s; "
+    "cached for later runs)..."
+)
+
+
+def _install_notice() -> None:
+    """Say once per process, on standard error, when a clpc kernel starts compiling.
+
+    A listener on numba's ``"numba:compile"`` event, which numba broadcasts only when it
+    compiles (a kernel loaded from the on-disk cache is silent).
+    """
+    if _NOTICE["installed"]:
+        return
+    _NOTICE["installed"] = True
+    try:
+        from numba.core import event
+    except ImportError:  # pragma: no cover - numba without the event module
+        return
+
+    class _Notice(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            dispatcher = (ev.data or {}).get("dispatcher")
+            module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+            if module.startswith("clpc.") and not _NOTICE["said"]:
+                _NOTICE["said"] = True
+                print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+
+        def on_end(self, ev: Any) -> None:
+            """Nothing to say at the end."""
+
+    event.register("numba:compile", _Notice())
 
 
 def _install_stamp() -> None:

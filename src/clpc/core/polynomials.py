@@ -16,7 +16,57 @@ import numpy as np
 
 from clpc.core.jit import compiled, kernel
 
-__all__ = ["monic", "monic_many", "schur_stable", "stable_many"]
+__all__ = [
+    "UNIT_CIRCLE_TOL",
+    "monic",
+    "monic_many",
+    "pole_class",
+    "pole_words",
+    "schur_stable",
+    "stable_many",
+]
+
+#: A pole closer than this to the unit circle is on it (an integrator at z = 1, or an
+#: undamped oscillation elsewhere): an integrator estimated from noisy data lands a few
+#: thousandths from z = 1 (the ball-and-beam record, whose beam integrates: 1.0015 at
+#: N = 1 and 2).
+UNIT_CIRCLE_TOL = 5e-3
+
+
+def pole_class(poles: np.ndarray, tol: float = UNIT_CIRCLE_TOL) -> str:
+    """How a model's poles sit against the unit circle, in one word.
+
+    Parameters
+    ----------
+    poles : ndarray of complex
+        The poles (roots of ``z^na A(z)``).
+    tol : float
+        Distance from the circle that counts as on it.
+
+    Returns
+    -------
+    str
+        ``"unstable"`` (a pole outside the circle by more than ``tol``), ``"integrating"``
+        (a pole within ``tol`` of ``z = 1``, none outside), ``"marginal"`` (a pole on the
+        circle elsewhere, e.g. ``z = -1``), else ``"stable"``.
+    """
+    p = np.asarray(poles, dtype=complex)
+    radius = np.abs(p)
+    if np.any(radius > 1.0 + tol):
+        return "unstable"
+    if np.any(np.abs(p - 1.0) <= tol):
+        return "integrating"
+    return "marginal" if np.any(radius >= 1.0 - tol) else "stable"
+
+
+def pole_words(kind: str) -> str:
+    """The words of a :func:`pole_class` for verdicts, summaries and the model's repr."""
+    return {
+        "stable": "stable",
+        "integrating": "integrating (pole at z = 1)",
+        "marginal": "marginally stable (pole on the unit circle)",
+        "unstable": "NOT stable (pole outside the unit circle)",
+    }[kind]
 
 
 @kernel

@@ -2,7 +2,9 @@
 
 Everything downstream (lag matrices, LPC, CLPC, models) trusts an :class:`IOData`:
 finite float64 arrays ``u`` of shape (n_samples, n_inputs) and ``y`` of shape
-(n_samples, n_outputs), a positive sample time and channel names.
+(n_samples, n_outputs), a positive sample time and channel names. A record may hold several
+experiments (:meth:`IOData.concat`), stacked along the sample axis; estimators build their
+lag vectors inside each experiment, never across a boundary.
 """
 
 from __future__ import annotations
@@ -13,45 +15,16 @@ from typing import Any
 
 import numpy as np
 
-from clpc.data.errors import DataError
-from clpc.data.samples import as_samples
+from clpc.data import processing
+from clpc.data.validation import (
+    DataError,
+    channel_names,
+    check_dt,
+    check_finite,
+    to_2d_float,
+)
 
-__all__ = ["DataError", "IOData", "as_iodata"]
-
-
-def _to_2d_float(values: Any, name: str) -> tuple[np.ndarray, list[str] | None]:
-    """Convert array-like data to a float64 array of shape (n_samples, n_channels).
-
-    The input policy is :func:`clpc.data.samples.as_samples`. Returns the array and the
-    column names found on pandas objects (else ``None``).
-    """
-    arr, columns = as_samples(values, name)
-    if arr.ndim == 0:
-        raise DataError(f"{name} must be 1-D or 2-D; got a scalar. Pass one value per sample.")
-    if arr.ndim == 1:
-        arr = arr[:, None]
-    elif arr.ndim != 2:
-        raise DataError(
-            f"{name} must be 1-D (one channel) or 2-D (n_samples, n_channels); "
-            f"got {arr.ndim}-D with shape {arr.shape}."
-        )
-    if arr.shape[0] == 0 or arr.shape[1] == 0:
-        raise DataError(f"{name} is empty (shape {arr.shape}); at least one sample is needed.")
-    # an owned copy: the caller's array is neither aliased nor made read-only
-    return np.array(arr, dtype=np.float64, order="C", copy=True), columns
-
-
-def _check_finite(arr: np.ndarray, name: str, channels: Sequence[str]) -> None:
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        kind = "NaN" if np.isnan(arr[row, col]) else "inf"
-        count = int(bad[:, col].sum())
-        raise DataError(
-            f"{name} channel '{channels[col]}' has {count} non-finite value(s); "
-            f"the first is {kind} at sample index {row}. "
-            "Remove or interpolate missing samples before identification."
-        )
+__all__ = ["DataError", "IOData", "as_iodata", "check_dt"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +42,9 @@ class IOData:
         per sample).
     input_names, output_names : sequence of str, optional
         Channel names; default ``u0, u1, ...`` / ``y0, y1, ...`` or the DataFrame columns.
+    experiments : sequence of int, optional
+        Samples of each experiment when the record holds several, in order (summing to
+        ``n_samples``); default one experiment. See :meth:`concat`.
 
     Notes
     -----
@@ -82,6 +58,7 @@ class IOData:
     dt: float = 1.0
     input_names: tuple[str, ...] = ()
     output_names: tuple[str, ...] = ()
+    experiments: tuple[int, ...] = ()
 
     def __init__(
         self,
@@ -90,9 +67,10 @@ class IOData:
         dt: float = 1.0,
         input_names: Sequence[str] | None = None,
         output_names: Sequence[str] | None = None,
+        experiments: Sequence[int] | None = None,
     ) -> None:
-        u_arr, u_cols = _to_2d_float(u, "u")
-        y_arr, y_cols = _to_2d_float(y, "y")
+        u_arr, u_cols = to_2d_float(u, "u")
+        y_arr, y_cols = to_2d_float(y, "y")
         if u_arr.shape[0] != y_arr.shape[0]:
             raise DataError(
                 "u and y must have the same number of samples; "
@@ -100,10 +78,11 @@ class IOData:
                 "Trim both records to a common time span."
             )
         dt = check_dt(dt)
-        in_names = _names(input_names, u_cols, u_arr.shape[1], "u", "input_names")
-        out_names = _names(output_names, y_cols, y_arr.shape[1], "y", "output_names")
-        _check_finite(u_arr, "u", in_names)
-        _check_finite(y_arr, "y", out_names)
+        in_names = channel_names(input_names, u_cols, u_arr.shape[1], "u", "input_names")
+        out_names = channel_names(output_names, y_cols, y_arr.shape[1], "y", "output_names")
+        check_finite(u_arr, "u", in_names)
+        check_finite(y_arr, "y", out_names)
+        parts = _experiments(experiments, u_arr.shape[0])
         u_arr.setflags(write=False)
         y_arr.setflags(write=False)
         object.__setattr__(self, "u", u_arr)
@@ -111,6 +90,7 @@ class IOData:
         object.__setattr__(self, "dt", dt)
         object.__setattr__(self, "input_names", in_names)
         object.__setattr__(self, "output_names", out_names)
+        object.__setattr__(self, "experiments", parts)
 
     @property
     def n_samples(self) -> int:
@@ -129,23 +109,165 @@ class IOData:
 
     @property
     def time(self) -> np.ndarray:
-        """Sample times ``k * dt`` [s], shape (n_samples,)."""
-        return np.arange(self.n_samples) * self.dt
+        """Sample times ``k * dt`` [s] from 0 in each experiment, shape (n_samples,)."""
+        starts = np.repeat(np.cumsum((0, *self.experiments[:-1])), self.experiments)
+        return (np.arange(self.n_samples) - starts) * self.dt
+
+    @property
+    def n_experiments(self) -> int:
+        """Number of experiments in the record."""
+        return len(self.experiments)
 
     def __len__(self) -> int:
         return self.n_samples
 
     def __getitem__(self, index: slice) -> IOData:
-        """Return the samples ``index`` (a slice) as a new :class:`IOData`."""
+        """Return the samples ``index`` (a slice) as a new :class:`IOData`.
+
+        A slice of several experiments keeps the boundaries that fall inside it (step 1 only).
+        """
         if not isinstance(index, slice):
             raise TypeError(f"IOData supports slicing only; got {type(index).__name__}.")
-        return IOData(self.u[index], self.y[index], self.dt, self.input_names, self.output_names)
+        start, stop, step = index.indices(self.n_samples)
+        parts: list[int] = []  # one experiment: whatever length the slice has
+        if self.n_experiments > 1:
+            if step != 1:
+                raise DataError("a record of several experiments can be sliced with step 1 only.")
+            ends = np.cumsum(self.experiments)
+            lo = np.clip(ends - np.asarray(self.experiments), start, max(stop, start))
+            parts = [int(n) for n in np.clip(ends, start, max(stop, start)) - lo if n > 0]
+        return self._with(self.u[index], self.y[index], experiments=parts)
 
     def __repr__(self) -> str:
+        more = f", experiments={list(self.experiments)}" if self.n_experiments > 1 else ""
         return (
             f"IOData(n_samples={self.n_samples}, inputs={list(self.input_names)}, "
-            f"outputs={list(self.output_names)}, dt={self.dt:g})"
+            f"outputs={list(self.output_names)}, dt={self.dt:g}{more})"
         )
+
+    def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> IOData:
+        """A new record with these samples and this record's names."""
+        parts = self.experiments if experiments is None else experiments
+        return IOData(
+            u, y, self.dt if dt is None else dt, self.input_names, self.output_names, parts
+        )
+
+    # ------------------------------------------------------------ experiments
+    @classmethod
+    def concat(cls, records: Sequence[IOData]) -> IOData:
+        """Several experiments as one record (their boundaries kept, see :meth:`split`).
+
+        Raises
+        ------
+        DataError
+            No record, or records with different sample times or channel names.
+        """
+        records = list(records)
+        if not records or not all(isinstance(r, IOData) for r in records):
+            raise DataError("concat needs a non-empty sequence of IOData records.")
+        first = records[0]
+        for i, r in enumerate(records[1:], 1):
+            if abs(r.dt - first.dt) > 1e-9 * first.dt:
+                raise DataError(
+                    f"experiment {i} has dt = {r.dt:g} s but experiment 0 has {first.dt:g} s; "
+                    "resample them to one sample time first (IOData.resample)."
+                )
+            if (r.input_names, r.output_names) != (first.input_names, first.output_names):
+                raise DataError(
+                    f"experiment {i} has channels {list(r.input_names)} -> "
+                    f"{list(r.output_names)} but experiment 0 has {list(first.input_names)} "
+                    f"-> {list(first.output_names)}; give every experiment the same channels."
+                )
+        return first._with(
+            np.concatenate([r.u for r in records]),
+            np.concatenate([r.y for r in records]),
+            experiments=[n for r in records for n in r.experiments],
+        )
+
+    def split(self) -> list[IOData]:
+        """One record per experiment."""
+        ends = np.cumsum(self.experiments)
+        return [
+            self._with(self.u[e - n : e], self.y[e - n : e], experiments=[n])
+            for n, e in zip(self.experiments, ends, strict=True)
+        ]
+
+    # ------------------------------------------------------------ preprocessing
+    def detrend(self, kind: str = "constant") -> IOData:
+        """Remove each channel's mean (``"constant"``) or line (``"linear"``) per experiment."""
+        both = processing.detrend_parts(np.hstack([self.u, self.y]), self.experiments, kind)
+        return self._with(both[:, : self.n_inputs], both[:, self.n_inputs :])
+
+    def filter(
+        self,
+        cutoff: float | Sequence[float],
+        btype: str = "lowpass",
+        order: int = 4,
+        zero_phase: bool = True,
+    ) -> IOData:
+        """Butterworth-filter every channel (see :func:`clpc.data.processing.filter_parts`).
+
+        ``cutoff`` [Hz]; ``zero_phase=True`` (default) filters forwards and backwards, so
+        the filter adds no delay (a causal filter would shift the estimated delay ``nk``).
+        """
+        both = processing.filter_parts(
+            np.hstack([self.u, self.y]), self.experiments, self.dt, cutoff, btype, order, zero_phase
+        )
+        return self._with(both[:, : self.n_inputs], both[:, self.n_inputs :])
+
+    def resample(self, dt: float) -> IOData:
+        """The record at sample time ``dt`` [s] (polyphase, anti-aliased; per experiment)."""
+        new_dt = check_dt(dt)
+        both, parts = processing.resample_parts(
+            np.hstack([self.u, self.y]), self.experiments, self.dt, new_dt
+        )
+        return self._with(both[:, : self.n_inputs], both[:, self.n_inputs :], new_dt, parts)
+
+    # ------------------------------------------------------------ DataFrames
+    def to_frame(self) -> Any:
+        """A pandas DataFrame: ``time`` [s], the inputs, the outputs (and ``experiment``)."""
+        import pandas as pd
+
+        columns: dict[str, Any] = {"time": self.time}
+        if self.n_experiments > 1:
+            columns["experiment"] = np.repeat(np.arange(self.n_experiments), self.experiments)
+        columns.update(zip(self.input_names, self.u.T, strict=True))
+        columns.update(zip(self.output_names, self.y.T, strict=True))
+        return pd.DataFrame(columns)
+
+    @classmethod
+    def from_frame(
+        cls,
+        frame: Any,
+        inputs: str | Sequence[str],
+        outputs: str | Sequence[str],
+        dt: float | None = None,
+        experiment: str | None = None,
+    ) -> IOData:
+        """A record from DataFrame columns (``experiment``: a column numbering experiments).
+
+        ``dt`` defaults to the frame's ``time`` column's mean step when it has one, else 1;
+        :meth:`to_frame` round-trips.
+        """
+        ins = [inputs] if isinstance(inputs, str) else list(inputs)
+        outs = [outputs] if isinstance(outputs, str) else list(outputs)
+        missing = [
+            c for c in (*ins, *outs, *([experiment] if experiment else [])) if c not in frame
+        ]
+        if missing:
+            raise DataError(
+                f"columns {missing} are not in the frame; it has {list(frame.columns)}."
+            )
+        parts = None
+        if experiment is not None:
+            labels = np.asarray(frame[experiment])
+            change = np.flatnonzero(labels[1:] != labels[:-1]) + 1
+            parts = np.diff([0, *change, labels.size]).tolist()
+        if dt is None and "time" in frame and len(frame) > 1:
+            t = np.asarray(frame["time"], dtype=np.float64)
+            first = t[: parts[0]] if parts else t
+            dt = float((first[-1] - first[0]) / (first.size - 1)) if first.size > 1 else None
+        return cls(frame[ins], frame[outs], 1.0 if dt is None else dt, ins, outs, parts)
 
     def plot(self, path: Any = None, *, title: str | None = None, ax: Any = None) -> Any:
         """Plot every channel against time; returns the figure (needs matplotlib).
@@ -166,34 +288,15 @@ class IOData:
             )
 
 
-def check_dt(dt: Any) -> float:
-    """``dt`` as a positive finite number of seconds (:class:`DataError` otherwise)."""
-    if isinstance(dt, (bool, np.bool_, str, bytes)):
-        raise DataError(f"dt (sample time) must be a number of seconds; got {dt!r}.")
-    try:
-        value = float(dt)
-    except (TypeError, ValueError, OverflowError):
-        raise DataError(f"dt (sample time) must be a number of seconds; got {dt!r:.60}.") from None
-    if not np.isfinite(value) or value <= 0:
+def _experiments(given: Sequence[int] | None, n: int) -> tuple[int, ...]:
+    if given is None or len(given) == 0:
+        return (n,)
+    parts = tuple(int(k) for k in given)
+    if any(k < 1 for k in parts) or sum(parts) != n:
         raise DataError(
-            f"dt (sample time) must be a positive finite number of seconds; got {dt!r}."
+            f"experiments must be positive sample counts summing to {n}; got {list(given)}."
         )
-    return value
-
-
-def _names(
-    given: Sequence[str] | None, found: list[str] | None, n: int, prefix: str, label: str
-) -> tuple[str, ...]:
-    if given is None:
-        given = found if found is not None and len(found) == n else None
-    if given is None:
-        return tuple(f"{prefix}{i}" for i in range(n)) if n > 1 else (prefix,)
-    if isinstance(given, str):
-        given = [given]
-    names = tuple(str(g) for g in given)
-    if len(names) != n:
-        raise DataError(f"{label} must name {n} channel(s); got {len(names)}: {list(names)}.")
-    return names
+    return parts
 
 
 def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: Any) -> IOData:
@@ -201,8 +304,9 @@ def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: An
 
     Parameters
     ----------
-    u : IOData or array_like, shape (n_samples,) or (n_samples, n_inputs)
-        A validated record, or the input samples.
+    u : IOData, sequence of IOData, or array_like, shape (n_samples,) or (n_samples, n_inputs)
+        A validated record, several experiments (joined by :meth:`IOData.concat`), or the
+        input samples.
     y : array_like, shape (n_samples,) or (n_samples, n_outputs), optional
         Output samples; required unless ``u`` is an :class:`IOData`.
     dt : float, optional
@@ -214,11 +318,15 @@ def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: An
     -------
     IOData
     """
+    if isinstance(u, (list, tuple)) and u and all(isinstance(r, IOData) for r in u):
+        if y is not None:
+            raise DataError("pass either records (IOData) or (u, y), not both.")
+        u = IOData.concat(u)  # several experiments: lag vectors stay inside each
     if isinstance(u, IOData):
         if y is not None:
             raise DataError("pass either an IOData or (u, y), not both.")
         if dt is not None and check_dt(dt) != u.dt:
-            return IOData(u.u, u.y, dt, u.input_names, u.output_names)
+            return IOData(u.u, u.y, dt, u.input_names, u.output_names, u.experiments)
         return u
     if y is None:
         raise DataError("y is missing: pass the outputs y together with the inputs u.")

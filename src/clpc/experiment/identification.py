@@ -41,7 +41,12 @@ def appraise(u: Any, y: Any, dt: float, method: str) -> Identification:
     result are the signals given (not decimated).
     """
     appraiser = CLPC(
-        PARAMETERS_SIZE, WINDOW_SIZE, CLUSTER_SIZE, SAMPLE_TIME, method=method, guard=GUARD
+        PARAMETERS_SIZE,
+        WINDOW_SIZE,
+        CLUSTER_SIZE,
+        decimate_to=SAMPLE_TIME,
+        method=method,
+        guard=GUARD,
     )
     u_arr, y_arr = np.asarray(u), np.asarray(y)
     trace = appraiser.run(u_arr, y_arr, dt=dt)

@@ -28,7 +28,7 @@ __all__ = ["claims", "render_report"]
 NOTES = """## Notes and workarounds
 
 - Anti-aliasing: the servo is logged at 1 ms and the appraiser decimates to 10 ms
-  (`CLPC(sample_time=0.01)` on data with dt = 1 ms); models are evaluated on the same decimated
+  (`CLPC(decimate_to=0.01)` on data with dt = 1 ms); models are evaluated on the same decimated
   signals (`clpc.experiment.decimate` reproduces the appraiser's filter exactly).
 - The actuator models are non-minimum-phase (a sampling zero); the torque is estimated with the
   stable non-causal inverse, not with `infer_input(allow_unstable=True)`, which diverges.

@@ -18,7 +18,7 @@ moves repeated with a 2 s period (the window length) plus a small PRBS dither.
 
 Signals flow as on a real drive: the servo is logged at 1 ms (the drive's trace buffer)
 and the appraiser works at Table 1's 10 ms ``sample_time``, anti-alias filtering and
-decimating the log itself (:class:`clpc.CLPC` with ``data_sample_time`` 1 ms). Every model
+decimating the log itself (:class:`clpc.CLPC` with ``dt`` 1 ms, ``decimate_to`` 10 ms). Every model
 is evaluated on the same decimated signals (:func:`clpc.appraiser.decimation.decimate` is
 the appraiser's own filter).
 

@@ -7,6 +7,7 @@ Where each job lives (one module each):
 - ``formats``: which format a file is (by its extension), and that it exists;
 - ``text_format``: delimiter and header detection of text files;
 - ``text_reader``: parsing text files batch by batch; ``text_writer``: writing them;
+- ``arrow_text``: the pyarrow fast path of ``text_reader`` (when pyarrow is installed);
 - ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
 - ``loading``: :func:`read_table`, :func:`iter_table_chunks` (dispatch by extension);
 - ``records``: :func:`load_iodata`; ``writing``: :func:`write_table`;

@@ -46,6 +46,8 @@ def _open_source(
     delimiter: str | None,
     header: bool | None,
     allow_missing: bool,
+    skip_rows: int = 0,
+    fast: bool = True,
     whole: bool = False,
 ) -> _Source:
     """Check the file, resolve the columns and pick the reader of the file's format.
@@ -55,8 +57,11 @@ def _open_source(
     """
     p = check_file(path)
     kind = file_kind(p)
+    skip = _check_skip_rows(skip_rows)
+    if skip and kind != "text":
+        raise DataError(f"skip_rows applies to text files only; {show(p)} is a {kind} file.")
     if kind == "text":
-        names, chunks = text_source(p, columns, delimiter, header, allow_missing)
+        names, chunks = text_source(p, columns, delimiter, header, allow_missing, skip, fast)
     elif kind == "parquet":
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
@@ -64,6 +69,13 @@ def _open_source(
     else:
         names, chunks = npz_source(p, columns, allow_missing, whole)
     return _Source(p, names, chunks)
+
+
+def _check_skip_rows(skip_rows: Any) -> int:
+    try:
+        return check_int(skip_rows, "skip_rows", low=0)
+    except ValueError as exc:
+        raise DataError(str(exc)) from None
 
 
 def _no_rows(path: Path) -> DataError:
@@ -83,6 +95,8 @@ def read_table(
     delimiter: str | None = None,
     header: bool | None = None,
     allow_missing: bool = False,
+    skip_rows: int = 0,
+    fast: bool = True,
 ) -> Table:
     """Read a whole data file into a :class:`Table`.
 
@@ -103,6 +117,13 @@ def read_table(
     allow_missing : bool
         Keep empty cells, nulls and NaN/inf as NaN instead of raising (default False:
         identification needs finite samples).
+    skip_rows : int
+        Text files only: physical lines to pass over at the top (e.g. a metadata line).
+        A units row right under the header (``s,m,m,V``) is skipped without asking.
+    fast : bool
+        Text files only: parse through pyarrow when it is installed (default), with the
+        plain reader taking over - and naming the line, column and text - wherever pyarrow
+        cannot vouch for a value (:mod:`clpc.io.arrow_text`). ``False``: the plain reader.
 
     Returns
     -------
@@ -120,7 +141,7 @@ def read_table(
     ImportError
         Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
-    src = _open_source(path, columns, delimiter, header, allow_missing, whole=True)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
     for values, where in src.chunks(_READ_CHUNK):
@@ -148,6 +169,8 @@ def iter_table_chunks(
     delimiter: str | None = None,
     header: bool | None = None,
     allow_missing: bool = False,
+    skip_rows: int = 0,
+    fast: bool = True,
 ) -> Iterator[tuple[list[str], np.ndarray]]:
     """Read a data file piece by piece, without holding it all in memory.
 
@@ -165,7 +188,7 @@ def iter_table_chunks(
         Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
         memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
         array in Fortran order and the pandas fallback for Parquet are loaded whole.
-    columns, delimiter, header, allow_missing
+    columns, delimiter, header, allow_missing, skip_rows, fast
         As for :func:`read_table`.
 
     Yields
@@ -181,7 +204,7 @@ def iter_table_chunks(
         As :func:`read_table`; errors in later rows surface when that chunk is reached.
     """
     chunk_rows = _check_chunk_rows(chunk_rows)
-    src = _open_source(path, columns, delimiter, header, allow_missing)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast)
 
     def generate() -> Iterator[tuple[list[str], np.ndarray]]:
         empty = True

@@ -3,8 +3,9 @@
 >>> from clpc.io import load_iodata                                   # doctest: +SKIP
 >>> data = load_iodata("run1.csv", inputs="u", outputs="y", time_column="t")  # doctest: +SKIP
 
-The sample time comes from ``dt=`` or from a time column, which must be increasing and
-uniformly sampled.
+The sample time comes from ``dt=`` or from a time column (in s, ms or us), which must be
+increasing and uniform within a tolerance (:mod:`clpc.data.timebase`), or is resampled onto a
+uniform grid on request.
 """
 
 from __future__ import annotations
@@ -15,6 +16,13 @@ import numpy as np
 
 from clpc.data import DataError
 from clpc.data.iodata import IOData, check_dt
+from clpc.data.timebase import (
+    DEFAULT_TIME_RTOL,
+    TIME_UNITS,
+    check_time_base,
+    resample_to_grid,
+)
+from clpc.data.timebase import time_unit as time_unit_of
 from clpc.io.errors import show
 from clpc.io.loading import read_table
 from clpc.io.table import ColumnKey, Columns, PathLike, Table
@@ -42,7 +50,10 @@ def load_iodata(
     time_column: ColumnKey | None = None,
     delimiter: str | None = None,
     header: bool | None = None,
-    time_rtol: float = 1e-6,
+    time_rtol: float = DEFAULT_TIME_RTOL,
+    time_unit: str | None = None,
+    resample: bool = False,
+    skip_rows: int = 0,
 ) -> IOData:
     """Read an input/output record from a data file.
 
@@ -54,16 +65,23 @@ def load_iodata(
         Input and output columns, by name or 0-based index; the names become the
         record's channel names.
     dt : float, optional
-        Sample time [s]. When ``time_column`` is also given, the time column must agree
-        with it (within ``time_rtol``).
+        Sample time [s]. With ``time_column`` it must agree with the column's mean step
+        (within ``time_rtol``); with ``resample`` it is the grid step.
     time_column : str or int, optional
-        A column of sample times [s]; ``dt`` is its mean step, and the steps must all be
-        equal within ``time_rtol`` (relative). Without ``dt`` and ``time_column`` the
-        sample time is 1 (per sample).
-    delimiter, header
+        A column of sample times; ``dt`` is its mean step, and the steps must be uniform
+        (:func:`clpc.data.timebase.check_time_base`). Without ``dt`` and ``time_column``
+        the sample time is 1 (per sample).
+    delimiter, header, skip_rows
         Text files only, as for :func:`read_table`.
     time_rtol : float
-        Relative tolerance of the uniform-sampling check (default 1e-6).
+        Largest relative deviation of one step from the median step (default 1e-2: a
+        jittery acquisition clock passes, a missing sample does not).
+    time_unit : {"s", "ms", "us"}, optional
+        Unit of the time column; default: the one its name says (``t_ms`` is in
+        milliseconds), else seconds.
+    resample : bool
+        Interpolate the record onto the uniform grid ``t0 + k dt`` (linear) instead of
+        refusing a time column that is not uniform (needs ``time_column``).
 
     Returns
     -------
@@ -74,23 +92,35 @@ def load_iodata(
     ------
     DataError
         Any problem of :func:`read_table`; a time column that is not increasing or not
-        uniformly sampled (the message names the first offending line/row); a ``dt``
-        that disagrees with the time column.
+        uniformly sampled (the message names the first offending line/row and what was
+        measured); a ``dt`` that disagrees with the time column; ``resample`` without a
+        time column.
     """
     in_keys = _keys(inputs, "inputs")
     out_keys = _keys(outputs, "outputs")
     keys = in_keys + out_keys + ([] if time_column is None else [time_column])
-    table = read_table(path, columns=keys, delimiter=delimiter, header=header)
+    table = read_table(path, columns=keys, delimiter=delimiter, header=header, skip_rows=skip_rows)
     n_in, n_out = len(in_keys), len(out_keys)
+    values = table.data[:, : n_in + n_out]
+    if resample and time_column is None:
+        raise DataError("resample needs a time column (time_column=, --time COL).")
     if time_column is not None:
-        step = _time_step(table, n_in + n_out, float(time_rtol))
-        if dt is None:
+        name = table.names[-1]
+        t = table.data[:, -1] * TIME_UNITS[time_unit_of(time_unit, name)]
+        if resample:
+            step, values = resample_to_grid(t, values, None if dt is None else check_dt(dt))
             dt = step
         else:
-            _check_dt_agrees(dt, step, table, time_rtol)
+            step = check_time_base(
+                t, f"{name!r} of {show(table.source)}", float(time_rtol), table.row_label
+            ).dt
+            if dt is None:
+                dt = step
+            else:
+                _check_dt_agrees(dt, step, table, time_rtol)
     return IOData(
-        table.data[:, :n_in],
-        table.data[:, n_in : n_in + n_out],
+        values[:, :n_in],
+        values[:, n_in : n_in + n_out],
         1.0 if dt is None else dt,
         input_names=table.names[:n_in],
         output_names=table.names[n_in : n_in + n_out],
@@ -106,39 +136,3 @@ def _check_dt_agrees(dt: float, step: float, table: Table, time_rtol: float) -> 
             f"{show(table.source)}, whose step is {step:.12g} s; pass only one of "
             "dt and time_column, or fix the time column."
         )
-
-
-def _time_step(table: Table, col: int, rtol: float) -> float:
-    """The sample time [s] of time column ``col``, after checking it is uniformly sampled."""
-    t = table.data[:, col]
-    name = table.names[col]
-    source = show(table.source)
-    if t.size < 2:
-        raise DataError(
-            f"time column {name!r} of {source} has {t.size} sample(s); at least 2 are needed "
-            "to find the sample time (or pass dt=)."
-        )
-    steps = np.diff(t)
-    nonpos = np.flatnonzero(steps <= 0)
-    if nonpos.size:
-        k = int(nonpos[0]) + 1
-        raise DataError(
-            f"time column {name!r} of {source} is not increasing at {table.row_label(k)} "
-            f"({t[k - 1]:.12g} -> {t[k]:.12g}); sort the record by time and remove repeated "
-            "samples."
-        )
-    typical = float(np.median(steps))
-    off = np.flatnonzero(np.abs(steps - typical) > rtol * typical)
-    if off.size:
-        k = int(off[0]) + 1
-        rel = abs(steps[k - 1] - typical) / typical
-        raise DataError(
-            f"time column {name!r} of {source} is not uniformly sampled: the step from "
-            f"{table.row_label(k - 1)} to {table.row_label(k)} is {steps[k - 1]:.12g} s but "
-            f"the typical (median) step is {typical:.12g} s (relative deviation {rel:.3g} > "
-            f"time_rtol={rtol:g}); resample the record onto a uniform grid (e.g. "
-            "numpy.interp), or loosen time_rtol if the times are rounded."
-        )
-    step = float((t[-1] - t[0]) / (t.size - 1))
-    rounded = float(f"{step:.12g}")  # 0.009999999999999998 -> 0.01
-    return rounded if abs(rounded - step) <= 1e-9 * step else float(step)

@@ -4,7 +4,9 @@ The delimiter is detected among tab, ``;``, ``,``, ``|`` and runs of whitespace 
 one that splits every sampled line into the same number (> 1) of fields). The first
 non-comment line is a header when one of its fields is not a number; otherwise the columns
 are named ``col0, col1, ...`` (or after a ``numpy.savetxt`` style ``#`` header line with
-the right number of names). Lines starting with ``#`` and blank lines are skipped;
+the right number of names); a units row under the header (every field text, e.g.
+``s,m,m,V``) is skipped, and so are ``skip_rows`` lines at the top (a metadata line). Lines
+starting with ``#`` and blank lines are skipped;
 ``"quoted"`` fields, Windows line endings, a UTF-8 byte order mark and gzip compression
 (``.csv.gz``) are understood.
 """
@@ -52,12 +54,16 @@ class TextFormat:
         1-based line of the header, None when the file has none.
     data_line : int
         1-based physical line where data reading starts.
+    units : list of str or None
+        The units row under the header (``s,m,m,V``: every field text), if there is one;
+        it is skipped.
     """
 
     delimiter: str | None
     names: list[str]
     header_line: int | None
     data_line: int
+    units: list[str] | None = None
 
     @property
     def n_cols(self) -> int:
@@ -157,13 +163,18 @@ def _choose_delimiter(delimiter: str | None, lines: list[str]) -> str | None:
     return delimiter
 
 
-def _first_lines(path: Path) -> tuple[list[str], list[tuple[int, str]]]:
-    """The comment lines before the data and up to 32 ``(line number, line)`` of data."""
+def _first_lines(path: Path, skip_rows: int = 0) -> tuple[list[str], list[tuple[int, str]]]:
+    """The comment lines before the data and up to 32 ``(line number, line)`` of data.
+
+    The first ``skip_rows`` physical lines (e.g. a metadata line) are passed over.
+    """
     comments: list[str] = []
     content: list[tuple[int, str]] = []
     with open_text(path) as f:
         try:
             for no, line in enumerate(f, 1):
+                if no <= skip_rows:
+                    continue
                 if is_content(line):
                     content.append((no, line))
                     if len(content) >= _SNIFF_LINES:
@@ -180,7 +191,7 @@ def _first_lines(path: Path) -> tuple[list[str], list[tuple[int, str]]]:
     return comments, content
 
 
-def sniff(path: Path, delimiter: str | None, header: bool | None) -> TextFormat:
+def sniff(path: Path, delimiter: str | None, header: bool | None, skip_rows: int = 0) -> TextFormat:
     """Read the first lines of a text data file and find its layout.
 
     Parameters
@@ -191,18 +202,22 @@ def sniff(path: Path, delimiter: str | None, header: bool | None) -> TextFormat:
         As for :func:`clpc.io.read_table`; None: detected.
     header : bool, optional
         Whether the first non-comment line holds column names; None: detected.
+    skip_rows : int
+        Physical lines to pass over first (a metadata line, a title).
 
     Returns
     -------
     TextFormat
-        Delimiter, column names and where the data starts.
+        Delimiter, column names and where the data starts. A line right under the header
+        whose every field is text (a units row such as ``s,m,m,V``) is recorded in
+        ``units`` and skipped.
 
     Raises
     ------
     DataError
         An empty file, a file that is not UTF-8 text, or an invalid ``delimiter``.
     """
-    comments, content = _first_lines(path)
+    comments, content = _first_lines(path, skip_rows)
     lines = [line for _, line in content]
     delim = _choose_delimiter(delimiter, lines)
     first = split_fields(lines[0], delim)
@@ -212,6 +227,10 @@ def sniff(path: Path, delimiter: str | None, header: bool | None) -> TextFormat:
         has_header = bool(header)
     if has_header:
         names = [f or f"col{i}" for i, f in enumerate(first)]
+        if len(content) > 1:
+            second = split_fields(lines[1], delim)
+            if len(second) == len(first) and all(f and not is_number(f) for f in second):
+                return TextFormat(delim, names, content[0][0], content[1][0] + 1, second)
         return TextFormat(delim, names, content[0][0], content[0][0] + 1)
     names = [f"col{i}" for i in range(len(first))]
     if comments and header is None:  # numpy.savetxt writes its header as "# a,b,c"

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from clpc.data import DataError
+from clpc.io.arrow_text import FallBack, arrow_batches, fast_path_applies
 from clpc.io.errors import cell_error, first_bad, parse_number, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 from clpc.io.text_format import (
@@ -47,9 +48,15 @@ class TextReader:
         The sorted unique 0-based columns to read.
     allow_missing : bool
         Keep empty cells and NaN/inf as NaN instead of raising.
+    fast : bool
+        Use pyarrow when it is installed (default); ``False``: the plain reader only (the
+        reference of the tests and benchmarks).
     """
 
-    def __init__(self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool):
+    def __init__(
+        self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool, fast: bool = True
+    ):
+        self.fast = fast
         self.path = path
         self.source = show(path)
         self.fmt = fmt
@@ -58,7 +65,32 @@ class TextReader:
         self.allow_missing = allow_missing
 
     def batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time."""
+        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time.
+
+        Through pyarrow when it is installed and the file is plain (:mod:`clpc.io.arrow_text`;
+        its blocks are re-cut into ``chunk_rows`` rows), else, and from the first block the
+        fast path cannot vouch for, by the plain reader.
+        """
+        done = 0
+        if self.fast and fast_path_applies(self.path, self.fmt):
+            try:
+                for values, rows in rechunk(
+                    arrow_batches(self.path, self.fmt, self.use, self.allow_missing), chunk_rows
+                ):
+                    yield values, rows
+                    done += values.shape[0]
+                return
+            except FallBack:
+                pass
+        for values, rows in self.plain_batches(chunk_rows):
+            if done >= values.shape[0]:
+                done -= values.shape[0]
+                continue
+            yield values[done:], rows[done:]
+            done = 0
+
+    def plain_batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """As :meth:`batches`, always by the plain reader (``numpy.loadtxt`` and Python)."""
         with open_text(self.path) as f:
             try:
                 for _ in range(self.fmt.data_line - 1):
@@ -187,6 +219,8 @@ def text_source(
     delimiter: str | None,
     header: bool | None,
     allow_missing: bool,
+    skip_rows: int = 0,
+    fast: bool = True,
 ) -> tuple[list[str], Chunks]:
     """Names of the selected columns of a text file and a chunk generator over them.
 
@@ -194,8 +228,10 @@ def text_source(
     ----------
     path : Path
         An existing text data file.
-    columns, delimiter, header, allow_missing
+    columns, delimiter, header, allow_missing, skip_rows
         As for :func:`clpc.io.read_table`.
+    fast : bool
+        Use pyarrow when installed (see :class:`TextReader`).
 
     Returns
     -------
@@ -207,10 +243,10 @@ def text_source(
     spool, given = None, path
     if not stat.S_ISREG(path.stat().st_mode):
         spool, path = _spool(path)
-    fmt = sniff(path, delimiter, header)
+    fmt = sniff(path, delimiter, header, skip_rows)
     sel = resolve_columns(fmt.names, columns, show(given))
     use = sorted(set(sel))
-    reader = TextReader(path, fmt, use, allow_missing)
+    reader = TextReader(path, fmt, use, allow_missing, fast)
     reader.source = show(given)
     batches = reader.batches
     if spool is not None:
@@ -233,3 +269,26 @@ def _spool(path: Path) -> tuple[tempfile.TemporaryDirectory[str], Path]:
     with open(path, "rb") as src, open(copy, "wb") as dst:
         shutil.copyfileobj(src, dst, 1 << 20)
     return folder, copy
+
+
+def rechunk(
+    blocks: Iterator[tuple[np.ndarray, np.ndarray]], chunk_rows: int
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The rows of ``blocks`` re-cut into pieces of exactly ``chunk_rows`` (the last fewer)."""
+    values: list[np.ndarray] = []
+    rows: list[np.ndarray] = []
+    held = 0
+    for v, r in blocks:
+        values.append(v)
+        rows.append(r)
+        held += v.shape[0]
+        if held < chunk_rows:
+            continue
+        all_v = values[0] if len(values) == 1 else np.concatenate(values)
+        all_r = rows[0] if len(rows) == 1 else np.concatenate(rows)
+        cut = held - held % chunk_rows
+        for lo in range(0, cut, chunk_rows):
+            yield all_v[lo : lo + chunk_rows], all_r[lo : lo + chunk_rows]
+        values, rows, held = [all_v[cut:]], [all_r[cut:]], held - cut
+    if held:
+        yield np.concatenate(values), np.concatenate(rows)

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from clpc.core import rules
+from clpc.core.checks import resolve_order
 from clpc.data import DataError, IOData, as_iodata
 from clpc.data.samples import check_spread
 from clpc.lpc import assessment
@@ -144,9 +145,14 @@ class LPC:
     order : int
         The paper's ``N`` (``parameters_size - 1``): ``na = nb = order``. Default 2.
     na, nb : int, optional
-        Separate output / input orders (override ``order``).
+        Separate output / input orders (override ``order``): ``A`` has ``na + 1``
+        coefficients ``a0..a_na`` and each ``B`` has ``nb + 1``, ``b0..b_nb`` applied to
+        ``u(n - nk) .. u(n - nk - nb)``. MATLAB's ``arx([na nb nk])`` counts the ``b``
+        coefficients instead: its ``nb`` is clpc's ``nb + 1`` (MATLAB ``[2 2 1]`` is
+        clpc ``na=2, nb=1, nk=1``).
     nk : int
-        Input delay in samples (default 0: ``b0`` present, as in the paper).
+        Input delay in samples (default 0: ``b0`` present, as in the paper; a physical plant
+        with no direct feed-through has ``nk >= 1``, as in MATLAB).
     method : {"robust", "paper"}
         ``"paper"``: the literal smallest eigenvector of the solved problem (the scatter
         matrix itself with the default ``scaling="none"``).
@@ -183,6 +189,9 @@ class LPC:
         Store the evidence the verdict cites (default ``True``;
         :func:`clpc.lpc.assessment.assess`): the fit of a refit on the first two thirds
         scored on the last third, and the residual tests.
+    parameters_size : int, optional
+        The paper's name for ``order + 1`` (an alias of ``order``; an ``order`` other than
+        the default given with it must agree).
 
     Notes
     -----
@@ -202,10 +211,14 @@ class LPC:
     cancel: bool = True
     uncertainty: bool = True
     assess: bool = True
+    parameters_size: int | None = None
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
-        return Structure.from_settings(self.order, self.na, self.nb, self.nk)
+        # order's default (2) cannot be told from an explicit 2: only another order conflicts
+        explicit = None if self.order == 2 else self.order
+        order = resolve_order(explicit, self.parameters_size, self.order)
+        return Structure.from_settings(order, self.na, self.nb, self.nk)
 
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
         """Identify the model from a record.

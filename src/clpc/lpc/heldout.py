@@ -22,12 +22,10 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.polynomials import UNIT_CIRCLE_TOL  # a pole this close to the circle is on it
+
 __all__ = ["HeldOutScore", "fit_percent", "horizon", "output_scores", "score", "stability"]
 
-#: A pole within this distance of the unit circle is on it (an integrator): an integrator
-#: estimated from noisy data lands a few thousandths from z = 1 (the ball-and-beam record,
-#: whose beam integrates: 1.0015 at N = 1 and 2).
-UNIT_CIRCLE_TOL = 5e-3
 #: Shortest prediction horizon [samples].
 MIN_HORIZON = 2
 #: Longest prediction horizon, as a share of the held-out samples.

@@ -86,12 +86,24 @@ CHECK_HORIZON = 10
 
 
 def _fits(model: LinearModel, data: IOData) -> tuple[float, float]:
-    """Free-run and k-step prediction fit % on the record (-inf when a prediction diverges)."""
-    with np.errstate(all="ignore"):
-        sim = np.asarray(model.simulate(data.u)).reshape(data.y.shape)
-        pred = np.asarray(model.predict(data.u, data.y, k=CHECK_HORIZON)).reshape(data.y.shape)
+    """Free-run and k-step prediction fit % on the record (-inf when a prediction diverges).
+
+    Each experiment of the record is simulated and predicted from its own start.
+    """
     start = model.structure.max_lag + CHECK_HORIZON
-    return fit_percent(data.y, sim), fit_percent(data.y[start:], pred[start:])
+    ys, sims, ys_k, preds = [], [], [], []
+    for part in data.split():
+        with np.errstate(all="ignore"):
+            sim = np.asarray(model.simulate(part.u)).reshape(part.y.shape)
+            pred = np.asarray(model.predict(part.u, part.y, k=CHECK_HORIZON)).reshape(part.y.shape)
+        ys.append(part.y)
+        sims.append(sim)
+        ys_k.append(part.y[start:])
+        preds.append(pred[start:])
+    return (
+        fit_percent(np.concatenate(ys), np.concatenate(sims)),
+        fit_percent(np.concatenate(ys_k), np.concatenate(preds)),
+    )
 
 
 def _theta(den: np.ndarray, num: np.ndarray, mode: str, j: int, nk: int) -> np.ndarray:

@@ -147,9 +147,13 @@ def regressors(data: IOData, structure: Structure, mode: MimoMode) -> np.ndarray
     Returns
     -------
     ndarray, shape (n_equations, n_rows, n_params)
-        ``n_equations = n_outputs``; ``n_rows = T - max_lag``.
+        ``n_equations = n_outputs``; ``n_rows = T - max_lag``, summed over the experiments
+        of a record that holds several (each experiment gives its own rows: no lag vector
+        reaches across a boundary).
     """
     check_mode(mode, data.n_inputs, data.n_outputs)
+    if data.n_experiments > 1:
+        return np.concatenate([regressors(part, structure, mode) for part in data.split()], axis=1)
     data.require_samples(
         structure.max_lag + 2,
         f"A model with na={structure.na}, nb={structure.nb}, nk={structure.nk}",

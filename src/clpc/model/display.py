@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.polynomials import pole_class, pole_words
+
 __all__ = ["model_html", "model_repr", "poly_text", "squeeze_info"]
 
 _NOWRAP = 'style="white-space:nowrap"'
@@ -130,9 +132,16 @@ def model_repr(model: Any) -> str:
             lines.append(f"  {out}: offset {eq['offset']:.6g}")
         if eq["stats"]:
             lines.append(f"  {out}: " + "  ".join(_stat_text(k, v) for k, v in eq["stats"].items()))
-    stable = "stable" if model.is_stable else "NOT stable"
-    lines.append(f"  ({stable}; G(z) = B(z)/A(z), powers of z^-1)")
+    lines.append(f"  ({_stability_words(model)}; G(z) = B(z)/A(z), powers of z^-1)")
     return "\n".join(lines)
+
+
+def _stability_words(model: Any) -> str:
+    """The stability in words (:func:`clpc.core.polynomials.pole_words`)."""
+    try:
+        return pole_words(model.stability)
+    except (ValueError, np.linalg.LinAlgError):  # no poles (a0 = 0)
+        return "no poles"
 
 
 def model_html(model: Any) -> str:
@@ -152,7 +161,8 @@ def model_html(model: Any) -> str:
             else f'<span style="white-space:nowrap">{p:.4g}</span>'
             for p in eq["poles"]
         )
-        stable = bool(np.all(np.abs(eq["poles"]) < 1.0))
+        kind = pole_class(eq["poles"])
+        stable = "yes" if kind == "stable" else f"<b>{esc(pole_words(kind))}</b>"
         stats = "<br>".join(
             f"<span {_NOWRAP}>{esc(_stat_text(k, v))}</span>" for k, v in eq["stats"].items()
         )
@@ -160,7 +170,7 @@ def model_html(model: Any) -> str:
             rows.append(
                 f"<tr><td>{esc(inp)} &rarr; {esc(eq['output'])}</td><td>{_poly_html(num)}</td>"
                 f"<td>{_poly_html(eq['den'])}</td><td {_NOWRAP}>{eq['offset']:.6g}</td>"
-                f"<td>{poles}</td><td>{'yes' if stable else '<b>NO</b>'}</td>"
+                f"<td>{poles}</td><td>{stable}</td>"
                 f"<td>{stats or '&ndash;'}</td></tr>"
             )
     head = (

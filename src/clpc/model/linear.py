@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from clpc.core.polynomials import monic
+from clpc.core.polynomials import monic, pole_class
 from clpc.model import display, simulation
 from clpc.model import uncertainty as _unc
 from clpc.model.errors import ModelError
@@ -168,6 +168,17 @@ class LinearModel:
     def is_stable(self) -> bool:
         """All poles strictly inside the unit circle."""
         return all(np.all(np.abs(self.poles(j)) < 1.0) for j in range(self.n_outputs))
+
+    @property
+    def stability(self) -> str:
+        """``"stable"``, ``"integrating"`` (a pole at z = 1), ``"marginal"`` or ``"unstable"``.
+
+        The worst over the outputs (:func:`clpc.core.polynomials.pole_class`); an integrator
+        (voltage -> position) is ``"integrating"``, not ``"unstable"``.
+        """
+        order = ("stable", "marginal", "integrating", "unstable")
+        kinds = [pole_class(self.poles(j)) for j in range(self.n_outputs)]
+        return max(kinds, key=order.index)
 
     def dc_gain(self) -> np.ndarray:
         """Static gains ``G(1)``, shape (n_outputs, n_inputs).

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import linalg, stats
+from scipy import linalg
 
 __all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
 
@@ -237,6 +237,8 @@ def residual_analysis(
         )
     m = int(min(max_lag, n // 4))
     uu = u2[model.structure.max_lag :] - u2[model.structure.max_lag :].mean(axis=0)
+    from scipy import stats  # scipy.stats costs ~0.5 s to import: only where it is used
+
     z = float(stats.norm.ppf(0.5 + 0.5 * level))
     lags = np.arange(m + 1)
     auto = np.empty((y2.shape[1], m + 1))
@@ -252,7 +254,9 @@ def residual_analysis(
             cross[j, i] = _correlations(e[:, j], uu[:, i], m)
             rho_u = _correlations(uu[:, i], uu[:, i], 2 * m)
             cov = _bartlett(rho_e, rho_u, m)
-            band[j, i] = z * np.sqrt(np.diag(cov)[np.abs(np.arange(-m, m + 1))] / n)
+            # the truncated Bartlett sum can dip below 0 for periodic records: no variance
+            var = np.maximum(np.diag(cov), 0.0)[np.abs(np.arange(-m, m + 1))]
+            band[j, i] = z * np.sqrt(var / n)
             r = cross[j, i, m:]  # tau = 0..M
             zeta = n * _quadratic(cov, r)
             outside = np.abs(r) > band[j, i, m:]
@@ -296,6 +300,8 @@ def _test(
 
 
 def _count(name: str, stat: float, dof: int, level: float, outside: np.ndarray) -> ResidualTest:
+    from scipy import stats
+
     threshold = float(stats.chi2.ppf(level, dof))
     return ResidualTest(
         name, stat, threshold, dof, int(outside.sum()), int(outside.size), stat <= threshold

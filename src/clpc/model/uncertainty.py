@@ -23,7 +23,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy import optimize, stats
 
 from clpc.model.errors import ModelError
 
@@ -81,6 +80,8 @@ def _dof(model: Any) -> np.ndarray:
 def _quantile(level: float, dof: np.ndarray) -> np.ndarray:
     if not 0.0 < level < 1.0:
         raise ValueError(f"level must be in (0, 1), e.g. 0.95; got {level!r}.")
+    from scipy import stats  # scipy.stats costs ~0.5 s to import: only where it is used
+
     tail = 0.5 + 0.5 * level
     return np.where(np.isfinite(dof), stats.t.ppf(tail, np.maximum(dof, 1.0)), stats.norm.ppf(tail))
 
@@ -158,6 +159,8 @@ def _matched_poles(den: np.ndarray, nominal: np.ndarray) -> np.ndarray:
     comp = np.zeros((den.shape[0], na, na))
     comp[:, 0, :] = -den[:, 1:]
     comp[:, np.arange(1, na), np.arange(na - 1)] = 1.0
+    from scipy import optimize
+
     roots = np.linalg.eigvals(comp)
     out = np.empty_like(roots)
     for i, r in enumerate(roots):  # one small assignment per perturbation, not per sample

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.polynomials import pole_class, pole_words
 from clpc.core.rules import MIN_HELDOUT_FIT
 
 __all__ = ["Verdict", "describe_trace", "fit_verdict"]
@@ -44,6 +45,9 @@ class Verdict:
         The input order the excitation was checked for (``nb + 1`` lags).
     messages : tuple of str
         Plain-language findings.
+    stability : str
+        ``"stable"``, ``"integrating"`` (a pole at z = 1: an integrator, not a failure),
+        ``"marginal"`` or ``"unstable"`` (:func:`clpc.core.polynomials.pole_class`).
     heldout_fit, heldout_kstep : float or None
         Held-out free-run and ``k``-step fit % (``None``: not assessed).
     residuals_independent, residuals_white : bool or None
@@ -59,6 +63,7 @@ class Verdict:
     stable: bool
     order: int
     messages: tuple[str, ...]
+    stability: str = "stable"
     heldout_fit: float | None = None
     heldout_kstep: float | None = None
     residuals_independent: bool | None = None
@@ -140,26 +145,21 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
     """The verdict of a fit (:meth:`clpc.LPC.fit`, :meth:`clpc.ARX.fit`) for one output."""
     info = model.info
     words, found = evidence(info, output)
+    stable, kind, said = _stability(model, output)
     if "n_null" not in info:  # e.g. least squares, or a CLPC steady-state model
-        try:
-            stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
-        except ValueError:
-            stable = False
         what = "no eigenvalue statistics" if words else "no fit statistics"
         notes = (
             *words,
             f"{what} (a least-squares, averaged or loaded model)",
-            "the model is stable" if stable else "the model is NOT stable",
+            f"the model is {said}",
         )
-        return Verdict(0, True, False, stable, model.structure.nb + 1, notes, **found)
+        return Verdict(
+            0, True, False, stable, model.structure.nb + 1, notes, stability=kind, **found
+        )
     n_null = int(np.atleast_1d(info["n_null"])[output])
     n_input = int(np.atleast_1d(info["n_input_relations"])[output])
     determined = bool(np.atleast_1d(info["determined"])[output])
     sep = float(np.atleast_1d(info["separation"])[output])
-    try:
-        stable = bool(np.all(np.abs(model.poles(output)) < 1.0))
-    except ValueError:
-        stable = False
     order = model.structure.nb + 1
     msgs = []
     if n_input:
@@ -190,8 +190,20 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             f"the parameters are poorly determined (smallest eigenvalue {sep:.2g} of the next):"
             " the data hardly prefer this model to others"
         )
-    msgs.append("the model is stable" if stable else "the model is NOT stable")
-    return Verdict(n_null, n_input == 0, determined, stable, order, (*words, *msgs), **found)
+    msgs.append(f"the model is {said}")
+    return Verdict(
+        n_null, n_input == 0, determined, stable, order, (*words, *msgs), stability=kind, **found
+    )
+
+
+def _stability(model: Any, output: int) -> tuple[bool, str, str]:
+    """Strictly stable; the pole class; its words (``"integrating (pole at z = 1)"``)."""
+    try:
+        poles = model.poles(output)
+    except ValueError:
+        return False, "unstable", "NOT stable (no poles)"
+    kind = pole_class(poles)
+    return bool(np.all(np.abs(poles) < 1.0)), kind, pole_words(kind)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:

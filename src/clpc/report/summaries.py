@@ -18,6 +18,7 @@ import numpy as np
 from clpc.analysis.metrics import fit_percent
 from clpc.appraiser.trace import SCALAR_KEYS, Trace
 from clpc.core.jsonable import jsonable
+from clpc.core.polynomials import pole_class
 from clpc.data import IOData
 from clpc.model import LinearModel, ModelError
 from clpc.model.residuals import residual_analysis
@@ -145,6 +146,7 @@ def model_summary(
                 "intercept": jsonable(icpt[j]),
                 "poles": [[jsonable(p.real), jsonable(p.imag)] for p in poles],
                 "stable": bool(np.all(np.abs(poles) < 1.0)),
+                "stability": pole_class(poles),
                 "D": stat("D", j),
                 "lambda_min": stat("lambda_min", j),
                 "eig_ratio": stat("eig_ratio", j),
@@ -177,6 +179,7 @@ def model_summary(
         "scaling": info.get("scaling"),
         "cancelled": info.get("cancelled", 0),
         "stable": model.is_stable,
+        "stability": model.stability,
         "equations": equations,
     }
     if data is not None:

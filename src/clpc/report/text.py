@@ -6,6 +6,8 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from clpc.core.polynomials import pole_words
+
 __all__ = ["format_fit", "format_model_summary"]
 
 
@@ -58,7 +60,7 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
         if eq["intercept"]:
             lines.append(f"  [{out}]  offset (intercept) {eq['intercept']:.6g}")
         poles = ", ".join(_fmt_complex(re, im) for re, im in eq["poles"])
-        lines.append(f"  [{out}]  poles: {poles}  -> {'stable' if eq['stable'] else 'UNSTABLE'}")
+        lines.append(f"  [{out}]  poles: {poles}  -> {_stability(eq)}")
         if eq["D"] is not None:
             lines.append(
                 f"  [{out}]  D = lambda_max - lambda_min = {eq['D']:.6g}   lambda_min = "
@@ -86,8 +88,16 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
             ]
         )
         lines.extend(f"  {t}" for t in summary["residual_test"]["tests"])
-    lines.append(f"model is {'stable' if summary['stable'] else 'UNSTABLE'}")
+    lines.append(f"model is {_stability(summary)}")
     return "\n".join(lines)
+
+
+def _stability(entry: Mapping[str, Any]) -> str:
+    """``stable``, ``integrating (pole at z = 1)``, ... (``UNSTABLE`` for older summaries)."""
+    kind = entry.get("stability")
+    if kind is None:
+        return "stable" if entry["stable"] else "UNSTABLE"
+    return pole_words(kind)
 
 
 def _fmt_complex(re: float, im: float) -> str:

@@ -7,8 +7,16 @@ from dataclasses import dataclass
 from typing import Literal
 
 from clpc.appraiser import CLPC
-from clpc.core.checks import check_bool, check_choice, check_int, check_positive
+from clpc.core.checks import (
+    check_bool,
+    check_choice,
+    check_int,
+    check_positive,
+    resolve_order,
+    same_setting,
+)
 from clpc.data import IOData
+from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
 from clpc.io import load_iodata
 from clpc.model import LinearModel
 
@@ -101,7 +109,17 @@ class RecordSpec:
     dt : float, optional
         Sample time [s].
     time_col : str, optional
-        Column of sample times [s] (uniformly spaced).
+        Column of sample times (uniform within ``time_rtol``; see
+        :mod:`clpc.data.timebase`).
+    time_unit : {"s", "ms", "us"}, optional
+        Unit of ``time_col``; default the one its name says (``t_ms``), else seconds.
+    time_rtol : float
+        Largest relative deviation of one time step from the median step.
+    resample : bool
+        Interpolate onto a uniform grid instead of refusing a jittery time column (whole
+        records only: not for ``track``).
+    skip_rows : int
+        Text files: physical lines to pass over at the top (a metadata line).
     """
 
     file: str
@@ -109,9 +127,19 @@ class RecordSpec:
     outputs: tuple[str, ...] = ()
     dt: float | None = None
     time_col: str | None = None
+    time_unit: str | None = None
+    time_rtol: float = DEFAULT_TIME_RTOL
+    resample: bool = False
+    skip_rows: int = 0
 
     def __post_init__(self) -> None:
         _optional_positive(self.dt, "dt")
+        check_positive(self.time_rtol, "time_rtol")
+        check_int(self.skip_rows, "skip_rows", 0)
+        if self.time_unit is not None:
+            check_choice(self.time_unit, "time_unit", tuple(TIME_UNITS))
+        if self.resample and self.time_col is None:
+            raise SettingsError("resample needs a time column (--time COL).")
 
     def check_sampling(self) -> None:
         """Refuse a record given both ``dt`` and ``time_col``.
@@ -156,6 +184,10 @@ class RecordSpec:
             column_keys(self.outputs),
             dt=self.dt,
             time_column=column_key(self.time_col),
+            time_rtol=self.time_rtol,
+            time_unit=self.time_unit,
+            resample=self.resample,
+            skip_rows=self.skip_rows,
         )
 
 
@@ -165,37 +197,50 @@ class AppraiserSettings:
 
     Parameters
     ----------
-    parameters_size : int
-        Size of ``a`` and of ``b`` (N + 1), at least 2.
+    order : int
+        Model order ``N`` (``na = nb = N``), at least 1.
     window : int
         Lag vectors per LPC window, at least 2.
     cluster : int
         Lag vectors between updates, at least 1.
     nk : int
         Input delay in samples.
-    sample_time : float, optional
-        Sample time [s] the appraiser works at (an integer multiple of the data's).
+    decimate_to : float, optional
+        Sample time [s] the appraiser works at (an integer multiple of the data's; the data
+        are low-pass filtered and decimated).
     method : {"robust", "paper"}
         LPC solution.
     guard : bool
         Accept estimates only from trusted windows (the default; ``False`` is the paper's
         appraiser, see :class:`clpc.CLPC`).
+    parameters_size : int, optional
+        The paper's name for ``order + 1`` (an alias; set to ``order + 1`` after checking).
+    sample_time : float, optional
+        Former name of ``decimate_to`` (an alias; set to ``decimate_to`` after checking).
     """
 
-    parameters_size: int = 3
+    order: int = 2
     window: int = 201
     cluster: int = 12
     nk: int = 0
-    sample_time: float | None = None
+    decimate_to: float | None = None
     method: Method = "robust"
     guard: bool = True
+    parameters_size: int | None = None
+    sample_time: float | None = None
 
     def __post_init__(self) -> None:
-        check_int(self.parameters_size, "parameters_size", 2)
+        explicit = None if self.order == 2 else self.order  # the default is not a choice
+        order = resolve_order(explicit, self.parameters_size, self.order)
+        target = same_setting(self.decimate_to, self.sample_time, "decimate_to", "sample_time")
+        object.__setattr__(self, "order", order)
+        object.__setattr__(self, "parameters_size", order + 1)
+        object.__setattr__(self, "decimate_to", target)
+        object.__setattr__(self, "sample_time", target)
         check_int(self.window, "window", 2)
         check_int(self.cluster, "cluster", 1)
         check_int(self.nk, "nk", 0)
-        _optional_positive(self.sample_time, "sample_time")
+        _optional_positive(self.decimate_to, "decimate_to")
         check_choice(self.method, "method", METHODS)
         check_bool(self.guard, "guard")
 
@@ -210,15 +255,15 @@ class AppraiserSettings:
         Returns
         -------
         CLPC
-            The appraiser, working at ``sample_time`` (default: ``data_dt``).
+            The appraiser, working at ``decimate_to`` (default: ``data_dt``).
         """
         return CLPC(
-            self.parameters_size,
-            self.window,
-            self.cluster,
-            self.sample_time or data_dt,
+            order=self.order,
+            window_size=self.window,
+            cluster_size=self.cluster,
+            dt=data_dt if data_dt is not None else (1.0 if self.decimate_to else None),
+            decimate_to=self.decimate_to,
             nk=self.nk,
-            data_sample_time=data_dt,
             method=self.method,
             guard=self.guard,
         )

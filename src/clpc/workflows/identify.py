@@ -15,7 +15,7 @@ from clpc.lpc import LPC, Identification, OrderSelection, identify, select_order
 from clpc.lpc.selection import ESTIMATORS
 from clpc.model import LinearModel, MimoMode
 from clpc.report import model_summary
-from clpc.workflows.common import METHODS, Method, RecordSpec
+from clpc.workflows.common import METHODS, Method, RecordSpec, SettingsError
 
 __all__ = ["IdentifyResult", "IdentifySettings", "identify_file"]
 
@@ -46,6 +46,9 @@ class IdentifySettings:
         Multi-channel structure.
     save : str, optional
         Save the model to this JSON file.
+    na, nb : int, optional
+        Separate output / input orders overriding ``order`` (clpc's meaning: ``nb + 1``
+        coefficients per input; MATLAB's ``arx`` nb is clpc's ``nb + 1``).
     estimator : {"auto", "lpc", "arx", "oe"}, optional
         Compare LPC, least squares and output error on held-out data (:func:`clpc.identify`)
         and keep this one (``"auto"``: the best). ``None`` (default): LPC alone, as before,
@@ -60,6 +63,8 @@ class IdentifySettings:
     method: Method = "robust"
     mimo: MimoMode | None = None
     save: str | None = None
+    na: int | None = None
+    nb: int | None = None
     estimator: str | None = None
 
     def __post_init__(self) -> None:
@@ -70,9 +75,19 @@ class IdentifySettings:
         if self.nk != "auto":
             check_int(self.nk, "nk", 0)
         check_choice(self.method, "method", METHODS)
+        for name in ("na", "nb"):
+            if getattr(self, name) is not None:
+                check_int(getattr(self, name), name, 0 if name == "nb" else 1)
+        if self.order == "auto" and (self.na is not None or self.nb is not None):
+            raise SettingsError("order auto chooses na = nb = N; do not also give na or nb.")
         if self.estimator is not None:
             check_choice(self.estimator, "estimator", ESTIMATORS)
         if self.compares:
+            if self.na is not None or self.nb is not None:
+                raise SettingsError(
+                    "na/nb apply to LPC alone; the estimator comparison (estimator or "
+                    "nk='auto') fits na = nb = N. Give --order instead, or drop the comparison."
+                )
             if self.method != "robust":
                 raise ValueError(
                     f"method={self.method!r} applies to LPC alone; the estimator comparison "
@@ -159,7 +174,9 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
     if settings.compares:
         return _compare(settings, data)
     assert settings.nk != "auto"
-    estimator = LPC(nk=settings.nk, method=settings.method, mimo=settings.mimo)
+    estimator = LPC(
+        nk=settings.nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
+    )
     selection = None
     order = settings.order
     if order == "auto":

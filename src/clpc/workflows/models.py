@@ -39,7 +39,11 @@ class SimulateResult:
 
 
 def simulate_file(
-    model_file: str, file: str, inputs: tuple[str, ...] = (), out: str | None = None
+    model_file: str,
+    file: str,
+    inputs: tuple[str, ...] = (),
+    out: str | None = None,
+    time_col: str | None = None,
 ) -> SimulateResult:
     """Simulate a saved model on the input columns of a file (free run, zero initial state).
 
@@ -53,6 +57,8 @@ def simulate_file(
         Input columns in the model's input order (default: the model's input names).
     out : str, optional
         Also write the result to this file (csv, tsv, parquet, npy, npz).
+    time_col : str, optional
+        A time column to carry into the result (its first column), unchanged.
 
     Returns
     -------
@@ -69,12 +75,15 @@ def simulate_file(
     """
     model = load_model(model_file)
     cols = model_columns(model, inputs, "input")
-    table = read_table(file, columns=column_keys(cols))
+    keys = column_keys(cols) + ([] if time_col is None else column_keys([time_col]))
+    table = read_table(file, columns=keys)
+    n_in = len(cols)
+    u = table.data[:, :n_in]
     with np.errstate(over="ignore", invalid="ignore"):
-        y_sim = np.asarray(model.simulate(table.data)).reshape(table.n_rows, -1)
+        y_sim = np.asarray(model.simulate(u)).reshape(table.n_rows, -1)
     _check_bounded(y_sim, model, model_file)
-    names = [*table.names, *(f"{n}_sim" for n in model.output_names)]
-    values = np.hstack([table.data, y_sim])
+    names = [*table.names[n_in:], *table.names[:n_in], *(f"{n}_sim" for n in model.output_names)]
+    values = np.hstack([table.data[:, n_in:], u, y_sim])
     if out:
         write_table(out, names, values)
     return SimulateResult(names, values, out)
@@ -186,6 +195,7 @@ def compare_file(settings: CompareSettings) -> CompareResult:
     outs = model_columns(model, settings.record.outputs, "output")
     record = dataclasses.replace(settings.record, inputs=tuple(ins), outputs=tuple(outs))
     data = record.load()
+    _check_sample_time(model.dt, data.dt, record)
     first = model.structure.max_lag + (settings.k or 1) - 1  # first sample scored
     if settings.k is not None and data.n_samples <= first + 1:
         raise DataError(
@@ -202,3 +212,24 @@ def compare_file(settings: CompareSettings) -> CompareResult:
 
         plot_compare(data.time, data.y, y_hat, fit, settings.plot, names=outs, label=what)
     return CompareResult(record.file, what, start, data.n_samples, fits, settings.plot or None)
+
+
+def _check_sample_time(model_dt: float, data_dt: float, record: RecordSpec) -> None:
+    """Refuse data sampled at another rate than the model's (when the data's rate is known).
+
+    Raises
+    ------
+    DataError
+        ``--dt``/``--time`` give a sample time that differs from the model's by more than
+        0.1 %.
+    """
+    if record.dt is None and record.time_col is None:
+        return  # the record does not say: the samples are taken at the model's rate
+    if abs(data_dt - model_dt) > 1e-3 * model_dt:
+        source = f"--time {record.time_col}" if record.time_col else f"--dt {record.dt:g}"
+        raise DataError(
+            f"the model was identified at dt = {model_dt:g} s but the data are sampled at "
+            f"dt = {data_dt:g} s ({source}); a discrete-time model only describes data at "
+            "its own rate. Resample the data (IOData.resample) or identify a model at "
+            "this rate."
+        )

@@ -92,9 +92,9 @@ class StreamSettings:
                 )
         if self.dt is not None and self.time_col is not None:
             raise SamplingConflictError()
-        if self.appraiser.sample_time is not None and self.dt is None and self.time_col is None:
+        if self.appraiser.decimate_to is not None and self.dt is None and self.time_col is None:
             raise SettingsError(
-                "--sample-time is the rate the appraiser works at (the data are decimated to "
+                "--decimate-to is the rate the appraiser works at (the data are decimated to "
                 "it); give the data's own sample time with --dt (or --time) as well."
             )
 

@@ -17,7 +17,9 @@ from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
 from clpc.core.figure import MAX_POINTS
 from clpc.data import DataError, IOData
+from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
+from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
@@ -69,9 +71,9 @@ class TrackSettings:
         check_int(self.chunk_rows, "chunk_rows", 1)
         check_int(self.figure_updates, "figure_updates", 1)
         record = self.record
-        if self.appraiser.sample_time is not None and record.dt is None and not record.time_col:
+        if self.appraiser.decimate_to is not None and record.dt is None and not record.time_col:
             raise SettingsError(
-                "--sample-time is the rate the appraiser works at (the data are decimated to "
+                "--decimate-to is the rate the appraiser works at (the data are decimated to "
                 "it); give the data's own sample time with --dt (or --time) as well."
             )
 
@@ -98,13 +100,15 @@ class TrackResult:
     files: list[Path]
 
 
-def count_data_lines(path: str) -> int | None:
-    """Data lines of an uncompressed text file (one header line assumed), else ``None``.
+def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
+    """Lines after the header (and a units row) of an uncompressed text file, else ``None``.
 
     Parameters
     ----------
     path : str
         A data file; only csv, tsv, tab, txt and dat files are counted.
+    skip_rows : int
+        Lines passed over at the top (see :func:`clpc.io.read_table`).
 
     Returns
     -------
@@ -118,34 +122,60 @@ def count_data_lines(path: str) -> int | None:
     with p.open("rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             lines += block.count(b"\n")
-    return max(lines - 1, 1)
+    try:
+        before = sniff(p, None, None, skip_rows).data_line - 1  # header, units, skipped
+    except DataError:
+        before = 1 + skip_rows
+    return max(lines - before, 1)
 
 
 class _Clock:
-    """Sample time from a time column read in chunks (uniform within ``rtol``)."""
+    """Sample time from a time column read in chunks.
 
-    def __init__(self, name: str, rtol: float = 1e-6) -> None:
-        self.name, self.rtol = name, rtol
+    The rule of :func:`clpc.data.timebase.check_time_base`, applied chunk by chunk: the
+    sample time is the first chunk's mean step; later samples keep to its grid as closely.
+    """
+
+    def __init__(self, record: RecordSpec) -> None:
+        self.name = str(record.time_col)
+        self.rtol = record.time_rtol
+        self.unit = record.time_unit
+        self.scale: float | None = None
         self.last: float | None = None
         self.dt: float | None = None
+        self.typical = 0.0
+        self.t0 = 0.0
         self.seen = 0
 
-    def feed(self, t: np.ndarray) -> None:
+    def feed(self, t: np.ndarray, name: str) -> None:
         if t.size == 0:
             return
-        full = t if self.last is None else np.concatenate([[self.last], t])
-        offset = self.seen - (0 if self.last is None else 1)
-        steps = np.diff(full)
-        if self.dt is None and steps.size:
-            self.dt = float(np.median(steps))
-        if self.dt is not None and steps.size:
-            bad = np.flatnonzero(~(np.abs(steps - self.dt) <= self.rtol * abs(self.dt)))
-            if bad.size or self.dt <= 0:
-                k = int(bad[0]) if bad.size else 0
+        if self.scale is None:
+            self.scale = TIME_UNITS[time_unit(self.unit, name)]
+        t = t * self.scale
+        if self.dt is None:
+            full = t if self.last is None else np.concatenate([[self.last], t])
+            if full.size >= 2:
+                base = check_time_base(
+                    full, repr(self.name), self.rtol, lambda k: f"data row {k + 1}"
+                )
+                self.dt, self.typical, self.t0 = base.dt, float(np.median(np.diff(full))), full[0]
+        else:
+            steps = np.diff(np.concatenate([[self.last], t]))
+            k = self.seen + np.arange(t.size)
+            dev = np.abs(steps - self.typical) / self.typical
+            drift = np.abs(t - (self.t0 + k * self.dt)) / self.dt
+            bad = np.flatnonzero(~((steps > 0) & (dev <= self.rtol) & (drift <= MAX_DRIFT_SAMPLES)))
+            if bad.size:
+                j = int(bad[0])
+                prev = self.last if j == 0 else t[j - 1]
                 raise DataError(
                     f"time column {self.name!r} is not uniformly increasing at data row "
-                    f"{offset + k + 2} ({full[k]:.12g} -> {full[k + 1]:.12g}; expected a step "
-                    f"of {self.dt:.12g} s); resample the record onto a uniform grid or use --dt."
+                    f"{self.seen + j + 1} ({prev:.12g} -> {t[j]:.12g}: step deviation "
+                    f"{dev[j]:.2g} relative, {drift[j]:.2g} samples off the grid of dt = "
+                    f"{self.dt:.12g} s; accepted: time_rtol={self.rtol:g}, drift <= "
+                    f"{MAX_DRIFT_SAMPLES:g} samples); resample the record onto a uniform grid, "
+                    "raise --time-rtol if the clock only jitters, or use --dt."
                 )
         self.last = float(t[-1])
         self.seen += t.size
@@ -202,7 +232,7 @@ def _tail(trace: Trace, n: int) -> Trace:
 class _SummaryTrace:
     """Every update of the run, with only the arrays :func:`trace_summary` reads.
 
-    104 bytes per update for one output with ``parameters_size=3`` (6 parameters), a third
+    104 bytes per update for one output with ``order=2`` (6 parameters), a third
     of a full trace row: a record of 1e7 samples with ``cluster=12`` (8.3e5 updates) keeps
     about 87 MB.
     """
@@ -240,12 +270,12 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
     """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``."""
     record = settings.record
     n_in, n_out = len(record.inputs), len(record.outputs)
-    clock = _Clock(record.time_col) if record.time_col else None
+    clock = _Clock(record) if record.time_col else None
     run: _Run | None = None
     with TraceWriter(trace_file) as writer:
         for names, values in _chunks(record, settings.chunk_rows, progress):
             if clock is not None:
-                clock.feed(values[:, n_in + n_out])
+                clock.feed(values[:, n_in + n_out], names[n_in + n_out])
                 if run is None and clock.dt is None:
                     raise DataError(
                         f"time column {record.time_col!r}: the first chunk has one sample; "
@@ -275,7 +305,9 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
 
 
 def _chunks(record: RecordSpec, chunk_rows: int, progress: ChunkFilter | None) -> Iterator[Chunk]:
-    chunks = iter_table_chunks(record.file, chunk_rows, columns=record.columns())
+    chunks = iter_table_chunks(
+        record.file, chunk_rows, columns=record.columns(), skip_rows=record.skip_rows
+    )
     return chunks if progress is None else progress(chunks)
 
 
@@ -286,7 +318,7 @@ def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> 
         raise DataError(
             f"the record is too short for the window: {run.appraiser.n_samples} sample(s) "
             f"(of {run.n_raw} read) but --window {settings.appraiser.window} with "
-            f"--parameters-size {settings.appraiser.parameters_size} needs at least {needed}; "
+            f"--order {settings.appraiser.order} needs at least {needed}; "
             "use a smaller --window or a longer record."
         )
 
@@ -345,6 +377,11 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         Unreadable record; a time column that is not uniform; too few samples.
     """
     settings.record.check_sampling()
+    if settings.record.resample:
+        raise SettingsError(
+            "track reads the record in chunks and cannot resample it; resample it first "
+            "(clpc.IOData.resample, or load_iodata(..., resample=True) and write_table)."
+        )
     out = Path(settings.out_dir)
     trace_file = out / f"trace.{settings.fmt}"
     run = _appraise(settings, trace_file, progress)

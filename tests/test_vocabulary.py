@@ -1,0 +1,223 @@
+"""One vocabulary: ``order`` everywhere (``parameters_size`` an alias), ``dt`` for the data's
+sample time and ``decimate_to`` for the appraiser's, ``compare`` checks the model's dt,
+``simulate`` keeps the time column, progress reaches a callback and the log."""
+
+from __future__ import annotations
+
+import logging
+import warnings
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from scipy import signal
+
+import clpc
+from clpc.cli import cli
+from clpc.io import read_table, write_table
+
+
+@pytest.fixture(scope="module")
+def record():
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(3000)
+    y = signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.5, 0.7], u) + 0.01 * rng.standard_normal(3000)
+    return u, y
+
+
+def _run(*args):
+    return CliRunner().invoke(cli, [str(a) for a in args])
+
+
+def test_lpc_parameters_size_is_an_alias_of_order(record):
+    u, y = record
+    a = clpc.LPC(order=3).fit(u, y)
+    b = clpc.LPC(parameters_size=4).fit(u, y)
+    np.testing.assert_array_equal(np.atleast_2d(a.theta), np.atleast_2d(b.theta))
+    with pytest.raises(ValueError, match="order and parameters_size name one setting"):
+        clpc.LPC(order=3, parameters_size=3).fit(u, y)
+
+
+def test_clpc_order_equals_parameters_size(record):
+    u, y = record
+    a = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)
+    b = clpc.CLPC(3, 101, 10).run(u, y)
+    np.testing.assert_array_equal(a.theta, b.theta)
+    assert clpc.CLPC(order=4).parameters_size == 5
+    assert "order=2" in repr(clpc.CLPC())
+    with pytest.raises(ValueError, match="parameters_size"):
+        clpc.CLPC(3, order=3)
+
+
+def test_dt_and_decimate_to_are_unambiguous(record):
+    u, y = record
+    new = clpc.CLPC(order=2, window_size=101, cluster_size=5, dt=0.01, decimate_to=0.02)
+    got = new.run(u, y)
+    with pytest.warns(DeprecationWarning, match="taken as the decimation target"):
+        old = clpc.CLPC(3, 101, 5, sample_time=0.02).run(u, y, 0.01)
+    np.testing.assert_array_equal(got.theta, old.theta)
+    assert got.sample_time == 0.02 and len(got) == len(old) > 0
+    # the data's own sample time: no decimation, the trace's time axis in seconds
+    plain = clpc.CLPC(order=2, window_size=101, cluster_size=5, dt=0.01).run(u, y)
+    assert plain.sample_time == 0.01 and len(plain) > len(got)
+    with pytest.warns(DeprecationWarning, match="taken as the data's sample time"):
+        legacy = clpc.CLPC(3, 101, 5, sample_time=0.01).run(u, y)
+    np.testing.assert_array_equal(legacy.theta, plain.theta)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the same rate: nothing ambiguous, no warning
+        clpc.CLPC(3, 101, 5, sample_time=0.01).run(u, y, 0.01)
+
+
+def test_decimate_to_needs_the_data_rate_and_dt_must_agree(record):
+    u, y = record
+    with pytest.raises(clpc.DataError, match="needs the data's sample time"):
+        clpc.CLPC(decimate_to=0.02).run(u, y)
+    with pytest.raises(clpc.DataError, match="must agree"):
+        clpc.CLPC(dt=0.01).run(clpc.IOData(u, y, dt=0.02))
+    with pytest.raises(ValueError, match="former, ambiguous name"):
+        clpc.CLPC(sample_time=0.01, decimate_to=0.02)
+    with pytest.raises(ValueError, match="dt and data_sample_time"):
+        clpc.CLPC(dt=0.01, data_sample_time=0.02)
+
+
+def test_state_round_trip_keeps_the_new_names(record):
+    u, y = record
+    a = clpc.CLPC(order=2, window_size=101, cluster_size=5, dt=0.01, decimate_to=0.02)
+    a.push(u[:1000], y[:1000])
+    b = clpc.CLPC.from_state_dict(a.state_dict())
+    assert (b.dt, b.decimate_to, b.order) == (0.01, 0.02, 2)
+    np.testing.assert_array_equal(
+        a.push(u[1000:], y[1000:]).theta, b.push(u[1000:], y[1000:]).theta
+    )
+
+
+def test_progress_callback_and_logging(record, caplog):
+    u, y = record
+    calls = []
+    appraiser = clpc.CLPC(order=2, window_size=101, cluster_size=10, chunk_samples=1024)
+    with caplog.at_level(logging.DEBUG, logger="clpc.appraiser"):
+        trace = appraiser.run(u, y, progress=lambda *a: calls.append(a))
+    assert [c[0] for c in calls] == [1024, 2048, 3000]
+    assert all(c[1] == 3000 for c in calls) and calls[-1][2] == len(trace)
+    assert sum("3000 of 3000 samples" in r.getMessage() for r in caplog.records) == 1
+
+
+def test_cli_track_order_and_former_parameters_size(tmp_path, record):
+    u, y = record
+    path = tmp_path / "r.csv"
+    write_table(path, ["u", "y"], np.column_stack([u, y]))
+    common = ["track", path, "-u", "u", "-y", "y", "--window", "101"]
+    a = _run(*common, "--order", "2", "--out", tmp_path / "a")
+    b = _run(*common, "--parameters-size", "3", "--out", tmp_path / "b")
+    assert a.exit_code == 0 and b.exit_code == 0, a.output + b.output
+    ta, tb = read_table(tmp_path / "a" / "trace.csv"), read_table(tmp_path / "b" / "trace.csv")
+    np.testing.assert_array_equal(ta.data, tb.data)
+    help_text = _run("track", "--help").output
+    assert "--order" in help_text and "--decimate-to" in help_text
+    assert "--parameters-size" not in help_text and "--sample-time" not in help_text
+
+
+def test_compare_refuses_another_rate_and_simulate_keeps_time(tmp_path, record):
+    u, y = record
+    path = tmp_path / "r.csv"
+    t = np.arange(u.size) * 0.01
+    write_table(path, ["t", "u", "y"], np.column_stack([t, u, y]))
+    model_file = tmp_path / "m.json"
+    assert _run("identify", path, "-u", "u", "-y", "y", "--dt", "0.01", "--save", model_file)
+    ok = _run("compare", model_file, path, "-u", "u", "-y", "y", "--time", "t")
+    assert ok.exit_code == 0, ok.output
+    bad = _run("compare", model_file, path, "-u", "u", "-y", "y", "--dt", "0.02")
+    assert bad.exit_code == 1 and "identified at dt = 0.01 s" in bad.output
+    sim = _run("simulate", model_file, path, "-u", "u", "--time", "t", "--out", tmp_path / "s.csv")
+    assert sim.exit_code == 0, sim.output
+    table = read_table(tmp_path / "s.csv")
+    assert table.names[:2] == ["t", "u"]
+    np.testing.assert_array_equal(table["t"], t)
+    model = clpc.load_model(model_file)
+    np.testing.assert_allclose(table["y_sim"], np.ravel(model.simulate(u)), rtol=1e-12)
+
+
+def test_track_progress_into_a_pipe_is_plain_lines(tmp_path, record):
+    u, y = record
+    path = tmp_path / "r.csv"
+    write_table(path, ["u", "y"], np.column_stack([u, y]))
+    res = CliRunner().invoke(
+        cli,
+        [
+            str(a)
+            for a in (
+                "track",
+                path,
+                "-u",
+                "u",
+                "-y",
+                "y",
+                "--window",
+                "101",
+                "--chunk-rows",
+                "1000",
+                "--progress",
+                "--out",
+                tmp_path / "o",
+            )
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("tracking:")]
+    assert lines == [
+        "tracking: 1000 of 3000 rows (33%)",
+        "tracking: 2000 of 3000 rows (67%)",
+        "tracking: 3000 of 3000 rows (100%)",
+    ]
+
+
+def test_integrating_is_not_unstable():
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(3000)
+    # voltage -> position: a pole at z = 1 and one at 0.7
+    y = clpc.simulate_arx([1, -1.7, 0.7], [0, 0.1, 0.05], u) + 1e-3 * rng.standard_normal(3000)
+    model = clpc.LPC(order=2, nk=1).fit(u, y, dt=0.01)
+    assert np.min(np.abs(model.poles() - 1.0)) < 1e-3
+    assert model.stability == "integrating" and not model.is_stable
+    assert "integrating (pole at z = 1)" in repr(model)
+    verdict = clpc.fit_verdict(model)
+    assert verdict.stability == "integrating" and "NOT stable" not in str(verdict)
+    assert "the model is integrating (pole at z = 1)" in str(verdict)
+    from clpc.core.polynomials import pole_class
+
+    assert pole_class(np.array([1.02, 0.5])) == "unstable"
+    assert pole_class(np.array([-1.0, 0.5])) == "marginal"
+    assert pole_class(np.array([0.99 + 0.0j, 0.5])) == "stable"
+    assert pole_class(np.array([0.998, 0.5])) == "integrating"
+
+
+def test_identify_na_nb(tmp_path, record):
+    u, y = record
+    path = tmp_path / "r.csv"
+    write_table(path, ["u", "y"], np.column_stack([u, y]))
+    res = _run(
+        "identify", path, "-u", "u", "-y", "y", "--na", "2", "--nb", "1", "--nk", "1", "--json"
+    )
+    assert res.exit_code == 0, res.output
+    ref = clpc.LPC(na=2, nb=1, nk=1).fit(u, y)
+    assert '"na": 2, "nb": 1, "nk": 1' in res.output
+    assert "MATLAB" in _run("identify", "--help").output
+    assert ref.num.size == 3  # nk = 1 leading zero, then nb + 1 = 2 coefficients
+    bad = _run("identify", path, "-u", "u", "-y", "y", "--order", "auto", "--na", "2")
+    assert bad.exit_code == 2 and "order auto" in bad.output
+
+
+def test_compare_exits_1_when_the_response_diverges(tmp_path):
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal(200)
+    y = clpc.simulate_arx([1, -1.05], [0, 0.5], u)  # an unstable plant, short record
+    model = clpc.ARX(order=1, nk=1).fit(u, y, dt=1.0)
+    assert model.stability == "unstable"
+    model_file = tmp_path / "m.json"
+    clpc.save_model(model, model_file)
+    long_u = rng.standard_normal(20000)
+    path = tmp_path / "long.csv"
+    write_table(path, ["u", "y"], np.column_stack([long_u, long_u]))
+    res = _run("compare", model_file, path, "-u", "u", "-y", "y")
+    assert res.exit_code == 1
+    assert "n/a (diverges)" in res.stdout and "diverges on this record" in res.stderr
