@@ -196,3 +196,20 @@ def test_estimator_name_of_other_methods():
         estimator_name({"method": "identify", "estimators": ["oe", "lpc"]}) == "identify: OE, LPC"
     )
     assert estimator_name({"method": None}) == "linear"
+
+
+def test_rank_deficient_fits_keep_the_model_and_say_why_there_is_no_covariance():
+    # two identical inputs: the regressors (and OE's Jacobian) are exactly rank deficient
+    rng = np.random.default_rng(9)
+    u1 = rng.standard_normal(300)
+    u = np.column_stack([u1, u1])
+    y = signal.lfilter([0.0, 1.0], [1.0, -0.5], u1) + 0.1 * rng.standard_normal(300)
+    for est in (clpc.ARX(order=1, assess=False), clpc.OE(order=1, assess=False)):
+        model = est.fit(u, y[:, None])
+        assert "covariance" not in model.info
+        assert "rank deficient" in model.info["covariance_note"]
+        with pytest.raises(ModelError, match="no parameter covariance"):
+            model.confidence_interval()
+    # badly scaled but well determined regressors (condition number ~1e7) keep theirs
+    v = np.column_stack([u1, 1e7 * rng.standard_normal(300)])
+    assert "covariance" in clpc.ARX(order=1, assess=False).fit(v, y[:, None]).info

@@ -102,9 +102,12 @@ class _Problem:
         # the simulation starts from the measured (noisy) y(s-1..s-na): their noise, white
         # like the output's, moves the estimate by -(J^T J)^-1 J^T G delta (G: the free
         # response to each start value), which the sandwich adds.
-        a = self.split(x)[0]
+        a, zeros = self.split(x)[0], np.zeros(res.size)
         g = np.column_stack(
-            [signal.lfilter([1.0], a, np.zeros(res.size), zi=zi)[0] for zi in _unit_states(a)]
+            [
+                signal.lfilter([1.0], a, zeros, zi=signal.lfiltic([1.0], a, past))[0]
+                for past in np.eye(self.na)  # a unit y(s-1-i), the others 0
+            ]
         )
         h = cov @ (jac.T @ g)
         cov = cov + h @ h.T / (float(res @ res) / dof)
@@ -329,9 +332,3 @@ def _start_vector(model: LinearModel, j: int, cols: list[int], structure: Struct
     if not np.all(np.isfinite(x0)):
         raise ModelError(f"the start model of output {j} has non-finite parameters.")
     return x0
-
-
-def _unit_states(a: np.ndarray) -> list[np.ndarray]:
-    """``lfilter`` states of ``1/A`` started from each unit past output (``na`` of them)."""
-    na = a.size - 1
-    return [signal.lfiltic([1.0], a, np.eye(na)[i]) for i in range(na)]
