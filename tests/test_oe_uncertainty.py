@@ -6,9 +6,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 from scipy import signal
 
 import clpc
+import clpc.datasets as ds
+from clpc.cli import cli
 from clpc.lpc import comparison
 from clpc.model import ModelError
 from clpc.report.summaries import model_summary
@@ -213,3 +216,15 @@ def test_rank_deficient_fits_keep_the_model_and_say_why_there_is_no_covariance()
     # badly scaled but well determined regressors (condition number ~1e7) keep theirs
     v = np.column_stack([u1, 1e7 * rng.standard_normal(300)])
     assert "covariance" in clpc.ARX(order=1, assess=False).fit(v, y[:, None]).info
+
+
+def test_cli_names_the_estimator_in_the_summary_and_the_report(tmp_path):
+    args = ["identify", str(ds.path("dryer")), "-u", "u", "-y", "y", "--nk", "3"]
+    res = CliRunner().invoke(cli, [*args, "--estimator", "oe", "--report", str(tmp_path / "r")])
+    assert res.exit_code == 0, res.output
+    assert "\nOE (output error) model  na=2 nb=2 nk=3  method=output-error" in res.output
+    assert "parameters (+- 1 sigma): a1" in res.output  # the OE covariance reaches the CLI
+    html = (tmp_path / "r" / "report.html").read_text()
+    assert "identify report (OE (output error) model)" in html
+    plain = CliRunner().invoke(cli, args)
+    assert plain.exit_code == 0 and plain.output.startswith("LPC model  na=2")
