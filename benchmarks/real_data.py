@@ -23,7 +23,9 @@ Methods:
 
 Scores on the validation part, every method on the same samples (from ``N`` on): ``sim`` =
 fit % of ``model.simulate(u_val)`` started from the measured outputs and inputs before
-sample ``N``; ``k10`` = ``clpc.kstep_fit(model, u, y, k=10)``. ``unstable``: a pole with
+sample ``N``; ``k10`` = ``clpc.kstep_fit(model, u, y, k=10)``, the model's own 10-step
+predictor (``LinearModel.predict`` honours ``info["noise_model"]``: the equation-error
+recursion for LPC and ARX, the free run for OE, per output for ``auto``). ``unstable``: a pole with
 |z| > 1 + 1e-9 (its free run is not scored and counts as -inf in the medians); ``(int)``:
 a pole on the unit circle (an integrator), reported apart. ``cancel``: pole/zero factors
 the new default removed (``model.info["cancelled"]``).

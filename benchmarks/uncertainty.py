@@ -6,7 +6,8 @@ analysis"):
 1. the share of 95 % intervals (:meth:`LinearModel.confidence_interval`) that contain each
    true parameter - LPC on errors-in-variables records (white and colored input, two
    lengths), least squares on records whose noise enters the output equation, and, as the
-   counter-example, least squares on records with noise on the output only (biased);
+   counter-example, least squares on records with noise on the output only (biased); OE on
+   those output-noise records (one and two inputs);
 2. delta-method standard deviations of a pole, the DC gain and ``|G|`` against the
    Monte-Carlo spread over the seeds;
 3. for the residual tests on correct ARX models: the share of lags inside the 95 % bands
@@ -67,6 +68,8 @@ def coverage(seeds: int) -> None:
         ("ARX, equation noise, N=400", clpc.ARX(order=2, assess=False), equation_noise, (400,)),
         ("ARX, equation noise, N=4000", clpc.ARX(order=2, assess=False), equation_noise, (4000,)),
         ("ARX, output noise only (biased)", clpc.ARX(order=2, assess=False), output_noise, (1000,)),
+        ("OE, output noise, N=200", clpc.OE(order=2, assess=False), output_noise, (200,)),
+        ("OE, output noise, N=1000", clpc.OE(order=2, assess=False), output_noise, (1000,)),
     ]
     for name, est, make, args in cases:
         hits = []
@@ -87,6 +90,16 @@ def coverage(seeds: int) -> None:
         hits.append((lo[0] <= truth) & (truth <= hi[0]))
     cover = np.mean(hits, axis=0)
     print(f"   {'LPC, EIV, 2 inputs (8 parameters)':<34s}" + "  ".join(f"{c:.3f}" for c in cover))
+    hits = []  # the same system, exact inputs, white noise on the output only
+    for seed in range(seeds):
+        rng = np.random.default_rng(seed)
+        u = rng.standard_normal((600, 2))
+        y = clpc.simulate_arx(DEN, NUM, u[:, 0]) + clpc.simulate_arx(DEN, num2, u[:, 1])
+        y = y + 0.5 * rng.standard_normal(600)
+        lo, hi = clpc.OE(order=2, assess=False).fit(u, y[:, None]).confidence_interval(0.95)
+        hits.append((lo[0] <= truth) & (truth <= hi[0]))
+    cover = np.mean(hits, axis=0)
+    print(f"   {'OE, output noise, 2 inputs, N=600':<34s}" + "  ".join(f"{c:.3f}" for c in cover))
 
 
 def delta_vs_monte_carlo(seeds: int) -> None:

@@ -137,7 +137,7 @@ def test_mixed_estimators_per_output_make_one_model():
     )
     y += 0.1 * rng.standard_normal(y.shape)
     data = clpc.as_iodata(u, y)
-    model = selection._final(data, ("arx", "oe"), 1, 0, None)
+    model = comparison.final_model(data, ("arx", "oe"), 1, 0, None)
     arx, oe = clpc.ARX(order=1).fit(data), clpc.OE(order=1).fit(data)
     np.testing.assert_allclose(model.theta[0], arx.theta[0])
     np.testing.assert_allclose(model.theta[1], oe.theta[1])

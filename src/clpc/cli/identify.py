@@ -23,6 +23,7 @@ from clpc.cli.options import (
 from clpc.cli.output import echo_json
 from clpc.lpc.selection import ESTIMATORS, pct
 from clpc.report import format_model_summary, write_identify_report
+from clpc.report.text import estimator_name
 from clpc.workflows import IdentifyResult, IdentifySettings, identify_file
 
 __all__ = ["identify"]
@@ -209,7 +210,7 @@ def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: st
         folder,
         result.model,
         record.load(),
-        title=f"LPC identify report: {Path(record.file).name}",
+        title=f"identify report ({estimator_name(result.summary)} model): {Path(record.file).name}",
         settings=shown,
         selection=result.summary.get("order_selection"),
     )

@@ -17,7 +17,12 @@ from scipy import signal
 from clpc.data import as_iodata
 from clpc.lpc import assessment
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from clpc.lpc.uncertainty import least_squares_covariance, monic_map, with_covariance
+from clpc.lpc.uncertainty import (
+    least_squares_covariance,
+    monic_map,
+    with_covariance,
+    without_covariance,
+)
 from clpc.model import LinearModel
 
 __all__ = ["ARX", "simulate_arx"]
@@ -64,15 +69,19 @@ class ARX:
         mats = regressors(data, structure, mode)
         mean = mats.mean(axis=1)
         thetas = np.empty((mats.shape[0], mats.shape[2]))
-        covs, dofs = [], []
+        covs, dofs, no_cov = [], [], ""
         for j, (m, z) in enumerate(zip(mats, mean, strict=False)):
             centered = m - z
             # y(n) = -[a1..; b..] . rest  ->  theta = [1, x]
             x, *_ = np.linalg.lstsq(centered[:, 1:], -centered[:, 0], rcond=None)
             thetas[j] = np.concatenate([[1.0], x])
-            if self.uncertainty:
+            if self.uncertainty and not no_cov:
                 resid = -centered[:, 0] - centered[:, 1:] @ x
-                cov_x, dof = least_squares_covariance(centered[:, 1:], resid)
+                try:
+                    cov_x, dof = least_squares_covariance(centered[:, 1:], resid)
+                except ValueError as exc:  # rank-deficient regressors: no finite covariance
+                    no_cov = f"output {data.output_names[j]}: {exc}"
+                    continue
                 lmap = monic_map(structure, data.n_inputs, mode, j)
                 covs.append(lmap @ cov_x @ lmap.T)
                 dofs.append(dof)
@@ -89,7 +98,9 @@ class ARX:
             output_names=data.output_names,
             info={"method": "least-squares"},
         )
-        if self.uncertainty:
+        if no_cov:
+            model = without_covariance(model, no_cov)
+        elif self.uncertainty:
             model = with_covariance(model, np.stack(covs), np.array(dofs), "least squares")
         if not self.assess:
             return model

@@ -11,10 +11,11 @@ from typing import Any
 import numpy as np
 
 from clpc.data import DataError, IOData
-from clpc.lpc import heldout
+from clpc.lpc import assessment, heldout
 from clpc.lpc.arx import ARX
 from clpc.lpc.estimator import LPC
 from clpc.lpc.oe import OE
+from clpc.lpc.uncertainty import with_covariance, without_covariance
 from clpc.model import LinearModel, ModelError
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "candidate",
     "choose",
     "choose_delay",
+    "final_model",
     "fold_fits",
     "grid",
     "tier",
@@ -33,6 +35,11 @@ __all__ = [
 PARSIMONY = 1.0
 MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
 _USABLE = ("stable", "integrating")
+
+
+def _cheap(**kw: Any) -> dict[str, Any]:
+    """Settings of a candidate fit: no covariance, no held-out assessment (scored here)."""
+    return kw | {"uncertainty": False, "assess": False}
 
 
 def fold_fits(model: LinearModel, seg: IOData, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -65,7 +72,7 @@ def candidate(
     radius = np.zeros(n_out)
     try:
         for est, val in folds:
-            model = MAKERS[name](order=order, nk=nk, mimo=mimo).fit(est)
+            model = MAKERS[name](**_cheap(order=order, nk=nk, mimo=mimo)).fit(est)
             radius = np.maximum(radius, [np.max(np.abs(model.poles(j))) for j in range(n_out)])
             f, p = fold_fits(model, val, k)
             free, kst = free + f / len(folds), kst + p / len(folds)
@@ -163,3 +170,68 @@ def choose_delay(
         scan.append({"nk": nk, "free_run": float(np.mean([rows[i]["free_run"] for i in best]))})
     chosen = int(max(scan, key=lambda r: r["free_run"])["nk"])  # the first of equals
     return chosen, scan, tables[chosen]
+
+
+def final_model(
+    data: IOData,
+    chosen: tuple[str, ...],
+    order: int,
+    nk: int,
+    mimo: str | None,
+    evidence: bool = True,
+) -> LinearModel:
+    """The chosen estimators refitted on the whole record (one model, one row per output).
+
+    One estimator: its own fit, with its covariance and evidence. A mix over the outputs:
+    each output's row, covariance (when every estimator stored one) and noise model
+    (``info["noise_model"]`` per output) from its estimator's fit; then the held-out fit and
+    residual tests of the mixed model (:func:`clpc.lpc.assessment.assess`, refitting the same
+    mix). ``evidence=False``: neither covariance nor assessment (the refit).
+    """
+    flags = {"uncertainty": evidence, "assess": evidence}
+    if len(set(chosen)) == 1:
+        return MAKERS[chosen[0]](order=order, nk=nk, mimo=mimo, **flags).fit(data)
+    fits = {}
+    for name in set(chosen):
+        kw: dict[str, Any] = {"order": order, "nk": nk, "mimo": mimo, **flags, "assess": False}
+        fits[name] = (LPC(**kw, cancel=False) if name == "lpc" else MAKERS[name](**kw)).fit(data)
+    first = fits[chosen[0]]
+    model = LinearModel(
+        theta=np.array([fits[name].theta_matrix[j] for j, name in enumerate(chosen)]),
+        structure=first.structure,
+        n_inputs=first.n_inputs,
+        mode=first.mode,
+        c=np.array([fits[name].c[j] for j, name in enumerate(chosen)]),
+        dt=first.dt,
+        input_names=first.input_names,
+        output_names=first.output_names,
+        info={
+            "method": "identify",
+            "estimators": list(chosen),
+            "noise_model": [
+                "output-error" if name == "oe" else "equation-error" for name in chosen
+            ],
+        },
+    )
+    if not evidence:
+        return model
+    notes = [
+        f"{name.upper()}: {fits[name].info.get('covariance_note', 'no covariance')}"
+        for name in set(chosen)
+        if "covariance" not in fits[name].info
+    ]
+    if notes:
+        model = without_covariance(model, "; ".join(sorted(notes)))
+    else:  # a mix has two outputs or more: info arrays keep their output axis
+        cov = np.stack([fits[name].info["covariance"][j] for j, name in enumerate(chosen)])
+        dof = [fits[name].info["covariance_dof"][j] for j, name in enumerate(chosen)]
+        how = ", ".join(
+            f"{out}: {fits[name].info['covariance_method']}"
+            for out, name in zip(first.output_names, chosen, strict=True)
+        )
+        model = with_covariance(model, cov, np.array(dof), f"per output ({how})")
+
+    def refit(part: IOData) -> LinearModel:
+        return final_model(part, chosen, order, nk, mimo, evidence=False)
+
+    return assessment.assess(model, data, refit)

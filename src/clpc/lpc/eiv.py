@@ -121,9 +121,15 @@ def check_eiv(
     """
     s = oe_model.structure
     if lpc_model is None:
-        lpc_model = LPC(na=s.na, nb=s.nb, nk=s.nk, mimo=oe_model.mode, cancel=False).fit(  # type: ignore[arg-type]
-            data
-        )
+        lpc_model = LPC(
+            na=s.na,
+            nb=s.nb,
+            nk=s.nk,
+            mimo=oe_model.mode,  # type: ignore[arg-type]
+            cancel=False,
+            uncertainty=False,
+            assess=False,
+        ).fit(data)
     p_oe = _monic(oe_model.theta)
     p_lpc = _monic(lpc_model.theta)
     p_exact = exact_input_tls(data, oe_model)[:, 1:]

@@ -25,17 +25,24 @@ output only, that is biased and the simulation error is not.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from scipy import optimize, signal
 
 from clpc.data import DataError, IOData, as_iodata
+from clpc.lpc import assessment
 from clpc.lpc.arx import ARX
 from clpc.lpc.estimator import LPC
 from clpc.lpc.reflection import MAX_KAPPA, poly_from_reflection, reflection_from_poly
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, lagged
+from clpc.lpc.uncertainty import (
+    covariance_from_jacobian,
+    monic_map,
+    with_covariance,
+    without_covariance,
+)
 from clpc.model import LinearModel, ModelError
 
 __all__ = ["OE"]
@@ -67,15 +74,47 @@ class _Problem:
     def residual(self, x: np.ndarray) -> np.ndarray:
         return self.y[self.s :] - self.simulate(x)[1]
 
-    def jacobian(self, x: np.ndarray) -> np.ndarray:
-        a, da_drho, _, _ = self.split(x)
+    def monic_jacobian(self, x: np.ndarray) -> np.ndarray:
+        """``d residual / d (a_1..a_na, b, k)``, shape (T - s, na + len(b) + 1)."""
+        a, _, _, _ = self.split(x)
         _, y_hat = self.simulate(x)
         full = np.concatenate([self.y[: self.s], y_hat])
         y_lags = lagged(full, self.na - 1, 1, self.s)  # y_hat(n-1) .. y_hat(n-na)
         cols = np.hstack([-y_lags, self.phi_u, np.ones((y_hat.size, 1))])
-        sens = signal.lfilter([1.0], a, cols, axis=0)  # d y_hat / d (a, b, k)
-        jac = -sens
+        return -signal.lfilter([1.0], a, cols, axis=0)  # -(d y_hat / d (a, b, k))
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        """``d residual / d x`` (``x = [rho; b; k]``: the chain rule through ``a(rho)``)."""
+        _, da_drho, _, _ = self.split(x)
+        jac = self.monic_jacobian(x)
         return np.hstack([jac[:, : self.na] @ da_drho, jac[:, self.na :]])
+
+    def covariance(self, x: np.ndarray, lmap: np.ndarray) -> tuple[np.ndarray, int]:
+        """Covariance of the monic vector of this output at the optimum ``x`` (see OE).
+
+        ``s^2 (J^T J)^-1`` with ``J`` taken with respect to ``(a_1..a_na, b, k)`` directly
+        (not ``rho``: its ``tanh`` flattens near the stability bound); the ``(a, b)`` block
+        is carried to ``np.r_[den[1:], num]`` by ``lmap`` (:func:`monic_map`, with the sign
+        of ``b`` flipped: here ``num = +b``).
+        """
+        jac, res = self.monic_jacobian(x), self.residual(x)
+        cov, dof = covariance_from_jacobian(jac, res)
+        # the simulation starts from the measured (noisy) y(s-1..s-na): their noise, white
+        # like the output's, moves the estimate by -(J^T J)^-1 J^T G delta (G: the free
+        # response to each start value), which the sandwich adds.
+        a, zeros = self.split(x)[0], np.zeros(res.size)
+        g = np.column_stack(
+            [
+                signal.lfilter([1.0], a, zeros, zi=signal.lfiltic([1.0], a, past))[0]
+                for past in np.eye(self.na)  # a unit y(s-1-i), the others 0
+            ]
+        )
+        h = cov @ (jac.T @ g)
+        cov = cov + h @ h.T / (float(res @ res) / dof)
+        n_ab = cov.shape[0] - 1  # drop the offset k
+        flip = np.r_[np.ones(self.na), -np.ones(n_ab - self.na)]
+        cov_x = flip[:, None] * cov[:n_ab, :n_ab] * flip[None, :]
+        return lmap @ cov_x @ lmap.T, dof
 
 
 @dataclass
@@ -92,13 +131,25 @@ class OE:
         The closed-form fits that start the search (default both).
     initial : LinearModel, optional
         An extra start (same structure and channels), tried beside ``starts``.
+    uncertainty : bool
+        Store the covariance of the monic parameters ``np.r_[den[1:], num]`` per output
+        (default ``True``): ``s^2 (J^T J)^-1``, ``J`` the Jacobian of the simulation errors
+        with respect to ``(a, b, k)`` at the optimum, ``s^2`` their sum of squares over
+        ``N - P`` (:func:`clpc.lpc.uncertainty.covariance_from_jacobian`). Valid when the
+        noise is white and on the output only (the output-error model); a rank-deficient
+        Jacobian leaves ``info["covariance_note"]`` instead.
+    assess : bool
+        Store the held-out fit and residual tests (default ``True``; as :class:`clpc.LPC`;
+        the residuals are the simulation errors).
 
     Notes
     -----
     The fit is local: it improves on the best of its starts and can stop in a local
     minimum. ``info`` holds per output ``start`` (which start won: ``"arx"``, ``"lpc"`` or
     ``"initial"``), ``cost`` (``sum of squared simulation errors / 2``), ``start_costs``
-    (the final cost from each start), ``nfev`` and ``success``.
+    (the final cost from each start), ``nfev`` and ``success``; ``info["noise_model"] =
+    "output-error"`` (white noise on the output: the model's ``k``-step predictor is its
+    free run, :meth:`LinearModel.predict`).
     """
 
     order: int = 2
@@ -109,6 +160,8 @@ class OE:
     max_nfev: int = 200
     starts: tuple[str, ...] = ("arx", "lpc")
     initial: LinearModel | None = None
+    uncertainty: bool = True
+    assess: bool = True
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
@@ -151,8 +204,10 @@ class OE:
         data.require_samples(structure.max_lag + p + 2, f"An OE fit with {p} parameters")
         starts = self._starts(data, structure, mode)
         thetas, cs = [], []
-        info: dict[str, Any] = {"method": "output-error"}
+        info: dict[str, Any] = {"method": "output-error", "noise_model": "output-error"}
         per_output: list[dict[str, Any]] = []
+        covs: list[tuple[np.ndarray, int]] = []
+        no_cov = ""
         for j in range(data.n_outputs):
             cols = range(data.n_inputs) if mode == "miso" else [j]
             prob = _Problem(
@@ -189,6 +244,12 @@ class OE:
                 )
             best = min(fits, key=lambda name: fits[name].cost)
             a, _, b, k = prob.split(fits[best].x)
+            if self.uncertainty and not no_cov:
+                try:
+                    lmap = monic_map(structure, data.n_inputs, mode, j)
+                    covs.append(prob.covariance(fits[best].x, lmap))
+                except ValueError as exc:
+                    no_cov = f"output {data.output_names[j]}: {exc}"
             theta = np.concatenate([a, -b])
             scale = np.linalg.norm(theta)
             thetas.append(theta / scale)
@@ -205,7 +266,7 @@ class OE:
         for key in ("start", "cost", "nfev", "success"):
             info[key] = np.array([row[key] for row in per_output])
         info["start_costs"] = [row["start_costs"] for row in per_output]
-        return LinearModel(
+        model = LinearModel(
             theta=np.array(thetas),
             structure=structure,
             n_inputs=data.n_inputs,
@@ -216,6 +277,15 @@ class OE:
             output_names=data.output_names,
             info=info,
         )
+        if no_cov:
+            model = without_covariance(model, no_cov)
+        elif self.uncertainty:
+            cov = np.stack([c for c, _ in covs])
+            dof = np.array([d for _, d in covs])
+            model = with_covariance(model, cov, dof, "Jacobian of the simulation error")
+        if not self.assess:
+            return model
+        return assessment.assess(model, data, replace(self, assess=False, uncertainty=False).fit)
 
     def _starts(self, data: IOData, structure: Structure, mode: str) -> dict[str, LinearModel]:
         """The least-squares and LPC fits (and ``initial``) that start the search."""
@@ -225,6 +295,8 @@ class OE:
             "nb": self.nb,
             "nk": self.nk,
             "mimo": mode,
+            "uncertainty": False,
+            "assess": False,
         }
         starts: dict[str, LinearModel] = {}
         if "arx" in self.starts:

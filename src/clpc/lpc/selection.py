@@ -38,18 +38,17 @@ from typing import Any
 import numpy as np
 
 from clpc.core.checks import check_choice, check_int
-from clpc.data import DataError, IOData, as_iodata
+from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
 from clpc.lpc.arx import ARX
 from clpc.lpc.comparison import (
-    MAKERS,
     choose,
     choose_delay,
+    final_model,
     grid,
     tier,
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
-from clpc.lpc.estimator import LPC
 from clpc.lpc.oe import OE
 from clpc.model import LinearModel, ModelError
 
@@ -174,7 +173,7 @@ def identify(
     folds = [(data[: data.n_samples - n_val], data[data.n_samples - n_val :])]
     folds.append((data[n_val:], data[:n_val]))
     if k is None:
-        k = heldout.horizon(ARX(order=orders[0], mimo=mimo).fit(folds[0][0]), n_val)  # type: ignore[arg-type]
+        k = heldout.horizon(ARX(order=orders[0], mimo=mimo, assess=False).fit(folds[0][0]), n_val)  # type: ignore[arg-type]
     k = check_int(k, "k", 1)
     delay_rows: list[dict[str, Any]] = []
     if len(delays) > 1:
@@ -187,11 +186,11 @@ def identify(
     for i in picks:
         rows[i]["chosen"] = True
     chosen = tuple(rows[i]["estimator"] for i in picks)
-    model = _final(data, chosen, pick_order, chosen_nk, mimo)
+    model = final_model(data, chosen, pick_order, chosen_nk, mimo)
     try:
         oe_model = model  # the chosen OE fit, or a new one
         if set(chosen) != {"oe"}:
-            oe_model = OE(order=pick_order, nk=chosen_nk, mimo=mimo).fit(data)  # type: ignore[arg-type]
+            oe_model = OE(order=pick_order, nk=chosen_nk, mimo=mimo, assess=False).fit(data)  # type: ignore[arg-type]
         eiv: EivCheck | None = check_eiv(data, oe_model)
     except (ModelError, DataError, np.linalg.LinAlgError):
         eiv = None
@@ -260,27 +259,3 @@ def pct(value: float) -> str:
     if not math.isfinite(value):
         return "diverges"
     return f"{value:.1f} %" if abs(value) < 1e4 else f"{value:.1e} %"
-
-
-def _final(
-    data: IOData, chosen: tuple[str, ...], order: int, nk: int, mimo: str | None
-) -> LinearModel:
-    """The chosen estimators refitted on the whole record (one model, one row per output)."""
-    if len(set(chosen)) == 1:
-        return MAKERS[chosen[0]](order=order, nk=nk, mimo=mimo).fit(data)
-    fits = {}
-    for name in set(chosen):
-        kw: dict[str, Any] = {"order": order, "nk": nk, "mimo": mimo}
-        fits[name] = (LPC(**kw, cancel=False) if name == "lpc" else MAKERS[name](**kw)).fit(data)
-    first = fits[chosen[0]]
-    return LinearModel(
-        theta=np.array([fits[name].theta_matrix[j] for j, name in enumerate(chosen)]),
-        structure=first.structure,
-        n_inputs=first.n_inputs,
-        mode=first.mode,
-        c=np.array([fits[name].c[j] for j, name in enumerate(chosen)]),
-        dt=first.dt,
-        input_names=first.input_names,
-        output_names=first.output_names,
-        info={"method": "identify", "estimators": list(chosen)},
-    )

@@ -130,7 +130,7 @@ def covariance_from_jacobian(
             f"than parameters; got J {jac.shape}, {res.size} residuals, {n_extra} extra."
         )
     _, s, vt = np.linalg.svd(jac, full_matrices=False)
-    if s[-1] <= s[0] * np.sqrt(np.finfo(float).eps) * max(n, p):
+    if s[-1] <= s[0] * np.finfo(float).eps * max(n, p):  # numerical rank (numpy's tolerance)
         raise ValueError(
             "the Jacobian is rank deficient (singular values "
             f"{s[0]:.3g} .. {s[-1]:.3g}): the data do not determine every parameter, so "

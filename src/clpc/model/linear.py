@@ -293,7 +293,11 @@ class LinearModel:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
 
         Each prediction uses measured outputs up to ``n - k`` and the model for the rest
-        (for ``k = 1`` the one-step-ahead predictor of the equation). The first
+        (for ``k = 1`` the one-step-ahead predictor of the equation). An output-error
+        model (``info["noise_model"] == "output-error"``, :class:`clpc.OE`; per output
+        for a list) assumes white noise on the output: its ``k``-step predictor is the free
+        run from the input for every ``k``, started from the measured samples before
+        ``max_lag`` (:func:`clpc.model.simulation.noise_models`). The first
         ``max_lag`` samples have no complete past and are returned as measured; the next
         ``k - 1`` can only use the measured start of the record, so they are predictions
         over fewer than ``k`` steps (:func:`clpc.kstep_fit` skips them).

@@ -4,8 +4,10 @@ Residuals ``e(t)`` (from sample ``max_lag`` on, mean removed) are the one-step p
 errors of the model's equation (``"prediction"``; for the ARX structure of LPC and least
 squares this is the equation error) or, for an output-error model, the free-run errors
 ``y - G u`` (``"simulation"``; chosen by ``"auto"`` when ``info["noise_model"] ==
-"output-error"``). With ``N`` residuals, ``M`` lags and ``rho`` the normalised sample
-autocorrelations (``rho_e(k) = sum_t e(t) e(t-k) / sum_t e(t)^2``):
+"output-error"``). A model that mixes noise models over its outputs gets ``"prediction"``:
+:meth:`LinearModel.predict` is the free run for its output-error outputs, so each output's
+residuals are its own model's errors. With ``N`` residuals, ``M`` lags and ``rho`` the
+normalised sample autocorrelations (``rho_e(k) = sum_t e(t) e(t-k) / sum_t e(t)^2``):
 
 **Whiteness** (are the residuals white?): Ljung-Box portmanteau
 ``Q = N (N+2) sum_{k=1}^{M} rho_e(k)^2 / (N-k)``, passed when ``Q <= chi2_level(M)``.
@@ -32,6 +34,8 @@ from typing import Any
 
 import numpy as np
 from scipy import linalg
+
+from clpc.model.simulation import noise_models
 
 __all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
 
@@ -214,7 +218,8 @@ def residual_analysis(
         Bad arguments, fewer than :data:`MIN_RESIDUALS` residuals, or diverging errors.
     """
     if kind == "auto":
-        kind = "simulation" if model.info.get("noise_model") == "output-error" else "prediction"
+        oe = {v == "output-error" for v in noise_models(model)}
+        kind = "simulation" if oe == {True} else "prediction"
     if kind not in ("prediction", "simulation"):
         raise ValueError(f"kind must be 'auto', 'prediction' or 'simulation'; got {kind!r}.")
     if not 0.0 < level < 1.0:

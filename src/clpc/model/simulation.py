@@ -13,7 +13,37 @@ from scipy import signal
 
 from clpc.model.errors import ModelError, as_2d
 
-__all__ = ["forced", "infer_input", "predict", "simulate"]
+__all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
+
+#: Values of ``info["noise_model"]``: ``"equation-error"`` (``A y = B u + e``, white ``e``:
+#: LPC, least squares; the default when the key is absent) and ``"output-error"``
+#: (``y = B/A u + e``, white ``e``: :class:`clpc.OE`).
+NOISE_MODELS = ("equation-error", "output-error")
+
+
+def noise_models(model: Any) -> list[str]:
+    """The noise model of each output, from ``info["noise_model"]``.
+
+    ``info["noise_model"]`` is absent (equation error), one of :data:`NOISE_MODELS` for
+    every output, or a list of them, one per output (a model that mixes estimators).
+
+    Returns
+    -------
+    list of str, length ``n_outputs``
+
+    Raises
+    ------
+    ModelError
+        An unknown value or a list of the wrong length.
+    """
+    value = model.info.get("noise_model", "equation-error")
+    out = [value] * model.n_outputs if isinstance(value, str) else list(value)
+    if len(out) != model.n_outputs or any(v not in NOISE_MODELS for v in out):
+        raise ModelError(
+            f"info['noise_model'] must be one of {NOISE_MODELS} or a list of them, one per "
+            f"output ({model.n_outputs}); got {value!r}."
+        )
+    return out
 
 
 def forced(model: Any, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
@@ -70,7 +100,14 @@ def simulate(
 
 
 def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
-    """``k``-step-ahead prediction ``y_hat(n | n-k)`` (:meth:`clpc.LinearModel.predict`)."""
+    """``k``-step-ahead prediction ``y_hat(n | n-k)`` (:meth:`clpc.LinearModel.predict`).
+
+    Equation-error outputs: the recursion below (measured outputs up to ``n - k``, the
+    model's own predictions after). Output-error outputs (:func:`noise_models`): the free
+    run from the input, started from the measured samples before ``max_lag`` - with white
+    noise on the output the past outputs carry no information about the future noise, so
+    that is the predictor for every ``k``.
+    """
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
     u2, _ = as_2d(u, model.n_inputs, "u")
@@ -94,6 +131,16 @@ def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
         cur[start:] = acc
         preds.append(cur)
     out = preds[k]
+    oe = [j for j, v in enumerate(noise_models(model)) if v == "output-error"]
+    if oe:
+        out = out.copy()
+        sim = simulate(
+            model,
+            u2[start:],
+            y_init=y2[:start] if na else None,
+            u_init=u2[:start] if start else None,
+        )
+        out[start:, oe] = np.asarray(sim).reshape(n - start, model.n_outputs)[:, oe]
     return out[:, 0] if (y_1d and model.n_outputs == 1) else out
 
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from clpc.model.errors import ModelError
+from clpc.model.simulation import noise_models
 
 __all__ = [
     "confidence_interval",
@@ -250,6 +251,17 @@ def parameter_labels(model: Any) -> list[str]:
     return labels + [f"b{k}[{name}]" for name in model.input_names for k in range(width)]
 
 
+def _equation(model: Any) -> str:
+    """The model's equation with its noise model (white ``e``)."""
+    forms = {"equation-error": "A(z) y = B(z) u + e", "output-error": "y = B(z)/A(z) u + e"}
+    kinds = noise_models(model)
+    if len(set(kinds)) == 1:
+        return forms[kinds[0]]
+    return "; ".join(
+        f"{name}: {forms[k]}" for name, k in zip(model.output_names, kinds, strict=True)
+    )
+
+
 def summary(model: Any) -> str:
     """The coefficients of every output with ``+- 1 sigma``, poles and DC gains, as text."""
     theta = parameter_vector(model)
@@ -264,7 +276,7 @@ def summary(model: Any) -> str:
         sigma, gain_std, how = np.full(theta.shape, np.nan), None, str(exc)
     lines = [
         f"{model!r}",
-        f"A(z) y = B(z) u + e, monic A, coefficient k of z^-k; {how}",
+        f"{_equation(model)}, monic A, coefficient k of z^-k; {how}",
     ]
     gains = model.dc_gain()
     for j, name in enumerate(model.output_names):

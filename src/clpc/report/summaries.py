@@ -116,7 +116,8 @@ def model_summary(
     Returns
     -------
     dict
-        Keys ``inputs``, ``outputs``, ``dt``, ``structure``, ``mode``, ``method``,
+        Keys ``inputs``, ``outputs``, ``dt``, ``structure``, ``mode``, ``method``
+        (and ``estimators``, one per output, for a model of :func:`clpc.identify`),
         ``stable``, ``equations`` (one dict per output: ``den``, ``num`` per input,
         ``intercept``, ``poles`` as ``[re, im]`` pairs, ``stable``, ``D``, ``lambda_min``,
         ``eig_ratio``, ``noise_variance``, ``determined``, ``n_input_relations``,
@@ -176,6 +177,7 @@ def model_summary(
         "structure": {"na": s.na, "nb": s.nb, "nk": s.nk},
         "mode": model.mode,
         "method": info.get("method"),
+        **({"estimators": list(info["estimators"])} if "estimators" in info else {}),
         "scaling": info.get("scaling"),
         "cancelled": info.get("cancelled", 0),
         "stable": model.is_stable,

@@ -8,7 +8,17 @@ from typing import Any
 
 from clpc.core.polynomials import pole_words
 
-__all__ = ["format_fit", "format_model_summary"]
+__all__ = ["estimator_name", "format_fit", "format_model_summary"]
+
+#: The estimator behind each ``info["method"]`` of a fitted model.
+_ESTIMATORS = {
+    "robust": "LPC",
+    "paper": "LPC",
+    "least-squares": "ARX (least squares)",
+    "output-error": "OE (output error)",
+    "clpc-steady-state": "CLPC",
+    "multimodel-linearization": "multi-model linearization",
+}
 
 
 def _poly(coefs: Sequence[float], var: str = "z^-1") -> str:
@@ -37,11 +47,25 @@ def format_fit(v: float | None) -> str:
     return f"{v:.2f} %" if abs(v) < 1e5 else f"{v:.3g} %"
 
 
+def estimator_name(summary: Mapping[str, Any]) -> str:
+    """The estimator that produced the model, from ``summary["method"]`` (and ``estimators``).
+
+    ``"LPC"``, ``"ARX (least squares)"``, ``"OE (output error)"``, ``"CLPC"``,
+    ``"identify: OE, ARX"`` (one estimator per output), else ``"linear"``.
+    """
+    method = summary.get("method")
+    if method == "identify":
+        names = [str(e).upper() for e in summary.get("estimators") or []]
+        return "identify: " + ", ".join(names) if names else "identify"
+    return _ESTIMATORS.get(str(method), "linear")
+
+
 def format_model_summary(summary: Mapping[str, Any]) -> str:
     """Render :func:`model_summary` as readable text (one block per output)."""
     st = summary["structure"]
     lines = [
-        f"LPC model  na={st['na']} nb={st['nb']} nk={st['nk']}  method={summary['method']}  "
+        f"{estimator_name(summary)} model  na={st['na']} nb={st['nb']} nk={st['nk']}  "
+        f"method={summary['method']}  "
         f"scaling={summary.get('scaling')}  mode={summary['mode']}  dt={summary['dt']:g} s"
         + (
             f"  ({summary['cancelled']} common pole/zero factor(s) cancelled)"
