@@ -499,6 +499,7 @@ def test_demo_quick(tmp_path):
     res = ok("demo", "--out", tmp_path, "--quick", "--duration", "3")
     assert "motor experiment finished" in res.output
     assert (tmp_path / "summary.json").exists()
+    assert "report.html" in res.output and (tmp_path / "report.html").exists()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert math.isfinite(summary["runtime_s"])
 

@@ -7,7 +7,9 @@ not a stored number.
 
 from __future__ import annotations
 
+import html
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +22,7 @@ from clpc.experiment import analysis, decimate, settings
 from clpc.experiment import run as ex
 from clpc.experiment.figures import FILES, RICH_FILE
 from clpc.experiment.report import render_report
+from test_report_html import check_images, heading_index, parse, render_in_chromium
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -51,6 +54,64 @@ def test_report_rerenders_from_saved_summary(run: tuple[dict[str, Any], Path]) -
     _, out = run
     saved = json.loads((out / "summary.json").read_text())
     assert render_report(saved) == (out / "report.md").read_text()
+
+
+# ---------------------------------------------------------------- report.html
+def _text(fragment: str) -> str:
+    """The text of an HTML fragment (tags dropped, entities decoded, spaces collapsed)."""
+    return " ".join(html.unescape(re.sub(r"<[^>]+>", " ", fragment)).split())
+
+
+def test_html_report_parses_and_reads_top_down(run: tuple[dict[str, Any], Path]) -> None:
+    summary, out = run
+    page = parse(out / "report.html")
+    assert {"name": "viewport", "content": "width=device-width, initial-scale=1"} in page.metas
+    check_images(page, out)  # every image it references exists beside it, as a PNG
+    assert not any(src.startswith(("data:", "/", "file:")) for src in page.images)  # relative
+    assert set(summary["figures"].values()) <= set(page.images)
+    nonlinear = summary["nonlinear_servo"]["figures"].values()
+    assert {Path(f).name for f in nonlinear} <= set(page.images)
+    # the same sections as report.md, in the same order: one text, two renderings
+    md_headings = re.findall(r"^## (.+)$", (out / "report.md").read_text(), flags=re.M)
+    assert page.headings[1:] == md_headings
+    assert page.headings[1] == "Verdicts at a glance"  # results first ...
+    assert heading_index(page, "Fig. 5") < heading_index(page, "Settings")
+    assert page.headings[-1] == "Settings"  # ... settings last, and folded
+    kinds = [k for k, _ in page.events]
+    assert kinds.count("details") == 1
+    assert page.events[kinds.index("details") + 1] == ("heading", "Settings")
+    assert kinds.index("warn") < kinds.index("img")  # the verdicts' box comes before figures
+
+
+def test_html_report_marks_every_claim_not_reproduced(run: tuple[dict[str, Any], Path]) -> None:
+    summary, out = run
+    doc = (out / "report.html").read_text()
+    box = _text(doc.split('<div class="warn"', 1)[1].split("</div>", 1)[0])
+    verdict_cells = {"not reproduced": 0, "partly": 0}
+    for claim in summary["claims"]:
+        for name, res in claim.items():
+            if isinstance(res, dict) and "verdict" in res:
+                if res["verdict"] != "reproduced":
+                    verdict_cells[res["verdict"]] += 1
+                    why = str(res.get("reason") or res["numbers"]).rstrip(".")
+                    line = f"{res['verdict'].upper()} ({name}): {claim['paper']}."
+                    assert line in box and why[1:] in box, (line, box[:300])
+                # each verdict's numbers and criterion are on the page (beside its figures)
+                assert res["numbers"] in _text(doc)
+                assert res["criterion"] in _text(doc)
+    assert verdict_cells["not reproduced"] > 0  # the quick run has claims to flag
+    assert doc.count('<td class="bad">') == verdict_cells["not reproduced"]
+    assert doc.count('<td class="partly">') == verdict_cells["partly"]
+
+
+@pytest.mark.slow
+def test_html_report_renders_in_headless_chromium(
+    run: tuple[dict[str, Any], Path], tmp_path: Path
+) -> None:
+    dom, pixels = render_in_chromium(run[1] / "report.html", tmp_path, (1200, 1800))
+    assert "<h2>Verdicts at a glance</h2>" in dom and 'class="warn"' in dom
+    assert "<summary>Settings</summary>" in dom
+    assert np.std(pixels[..., :3]) > 0.05  # not a blank page: text, tables, figures drawn
 
 
 def test_settings_are_table_1(run: tuple[dict[str, Any], Path]) -> None:

@@ -195,33 +195,41 @@ def test_report_without_dt_is_labelled_in_samples(tmp_path):
     assert {a.get_xlabel() for a in bode.axes} == {"frequency [cycles/sample]"}
 
 
-@pytest.mark.slow
-def test_report_renders_in_headless_chromium(track_report, tmp_path):
+def render_in_chromium(page: Path, tmp_path: Path, size: tuple[int, int] = (1000, 1400)):
+    """Render ``page`` in headless Chromium: (the DOM it built, the screenshot's pixels).
+
+    Skips the calling test, with the reason, where no chromium is installed.
+    """
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
     if browser is None:
         pytest.skip("no chromium on PATH: the headless rendering check needs a real browser")
-    _, files, _ = track_report
     shot = tmp_path / "shot.png"
     cmd = [
         browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1000,1400",
+        f"--user-data-dir={tmp_path / 'profile'}", f"--window-size={size[0]},{size[1]}",
     ]  # fmt: skip
     dom = subprocess.run(
-        [*cmd, "--dump-dom", files[-1].resolve().as_uri()],
+        [*cmd, "--dump-dom", page.resolve().as_uri()],
         capture_output=True, text=True, timeout=120, check=True,
     ).stdout  # fmt: skip
-    assert "<h2>Result</h2>" in dom and 'class="warn"' in dom and "<summary>Settings" in dom
     subprocess.run(
-        [*cmd, f"--screenshot={shot}", files[-1].resolve().as_uri()],
+        [*cmd, f"--screenshot={shot}", page.resolve().as_uri()],
         capture_output=True, timeout=120, check=True,
     )  # fmt: skip
-    data = shot.read_bytes()
-    assert data[:8] == PNG
+    assert shot.read_bytes()[:8] == PNG
     from matplotlib.image import imread
 
     pixels = imread(shot)
-    assert pixels.shape[:2] == (1400, 1000)
+    assert pixels.shape[:2] == (size[1], size[0])
+    return dom, pixels
+
+
+@pytest.mark.slow
+def test_report_renders_in_headless_chromium(track_report, tmp_path):
+    _, files, _ = track_report
+    dom, pixels = render_in_chromium(files[-1], tmp_path)
+    assert "<h2>Result</h2>" in dom and 'class="warn"' in dom and "<summary>Settings" in dom
     assert np.std(pixels[..., :3]) > 0.05  # not a blank page: text, tables, figures drawn
 
 

@@ -120,9 +120,9 @@ Seed {s["seed"]}; quick = {s["quick"]}; run time {summary["runtime_s"]:.1f} s.
 
 
 def verdict_table(summary: dict[str, Any]) -> str:
-    """One row per claim: its figures, the criterion, and the verdict for each command."""
+    """One row per claim: the verdict for each command (beside the claim), figures, criterion."""
     rows = [
-        "| paper's claim | figures | criterion | ramp (Fig. 5) | rich command |",
+        "| paper's claim | ramp (Fig. 5) | rich command | figures | criterion |",
         "|---|---|---|---|---|",
     ]
     for c in summary["claims"]:
@@ -132,7 +132,7 @@ def verdict_table(summary: dict[str, Any]) -> str:
         first: dict[str, Any] = next((c[n] for n in columns if n in c), {})
         crit = first.get("criterion", "-").replace("|", "\\|")  # a cell: escape the bars
         cells += ["-"] * (2 - len(cells))
-        rows.append(f"| {c['paper']} | {figs} | {crit} | {cells[0]} | {cells[1]} |")
+        rows.append(f"| {c['paper']} | {cells[0]} | {cells[1]} | {figs} | {crit} |")
     return "\n".join(rows) + "\n"
 
 

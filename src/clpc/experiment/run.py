@@ -8,8 +8,9 @@ identifications,
 * (b) the motor as actuator, torque command -> measured position (Figs. 13-14);
 
 and writes the paper's Figs. 5-17 (:mod:`clpc.experiment.figures`), ``summary.json`` (the
-numbers behind them) and ``report.md`` (every figure beside the claim it tests,
-:mod:`clpc.experiment.report`).
+numbers behind them), ``report.md`` (every figure beside the claim it tests,
+:mod:`clpc.experiment.report`) and ``report.html`` (the same text as a web page,
+:mod:`clpc.experiment.html_report`).
 
 Two commands are used. The paper's ramp with saturation (Fig. 5) gives the main figures;
 it excites the loop only while it ramps (its second difference is zero except at the two
@@ -24,7 +25,7 @@ the appraiser's own filter).
 
 Data flow (no module imports one above it): ``settings`` -> ``results`` -> ``analysis``,
 ``statistics``, ``identification`` -> ``evaluation`` -> ``claim_checks`` -> ``claims`` ->
-``markdown`` -> ``sections`` -> ``report``; ``marks`` -> ``figure_base``,
+``markdown`` -> ``sections`` -> ``report`` -> ``html_report``; ``marks`` -> ``figure_base``,
 ``figures_signals`` -> ``figures``; ``run`` (this module) calls them all. A further section
 of the demo is one more ``analyse_*`` call here, its numbers one more key of the summary.
 """
@@ -48,6 +49,7 @@ from clpc.experiment.evaluation import (
     torque_without_friction,
 )
 from clpc.experiment.figures import write_figures
+from clpc.experiment.html_report import render_html_report
 from clpc.experiment.nonlinear import nonlinear_claim, run_nonlinear
 from clpc.experiment.report import render_report
 from clpc.experiment.settings import (
@@ -115,7 +117,7 @@ def run_experiment(
     ----------
     out_dir : str or Path
         Output folder (created): ``fig05_command.png`` ... ``fig17_position_error.png``,
-        ``figR_rich_command.png``, ``summary.json``, ``report.md``.
+        ``figR_rich_command.png``, ``summary.json``, ``report.md``, ``report.html``.
     duration : float, optional
         Length of both records [s], at least 3. Default: 3.4 s for the ramp (until the
         ramp leaves the 2 s window) and 20 s (quick: 8 s) for the rich command.
@@ -158,4 +160,5 @@ def run_experiment(
     summary = jsonable(summary)
     (out / "summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
     (out / "report.md").write_text(render_report(summary), encoding="utf-8")
+    render_html_report(summary, out / "report.html")  # the same text as a web page
     return summary

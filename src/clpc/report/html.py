@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Section", "write_html_report"]
+__all__ = ["Section", "warnings_html", "write_html_report"]
 
 #: an image: its file, or its file and a caption
 Image = str | PathLike[str] | tuple[str | PathLike[str], str]
@@ -30,6 +30,7 @@ class Section:
     Parameters
     ----------
     heading : str
+        Section heading ("" for an untitled section, e.g. an introduction).
     text : str, optional
         Paragraph text (escaped; blank lines separate paragraphs).
     table : mapping or sequence of rows, optional
@@ -73,6 +74,9 @@ _CSS = (
     ".ok{border:2px solid #3c9a5f;background:#edf8f0;padding:.5em 1em;margin:.8em 0;"
     "border-radius:4px}"
     "details>summary{cursor:pointer;font-size:1.5em;font-weight:bold;margin-top:1.2em}"
+    "blockquote{margin:.8em 0;padding:.1em 1em;border-left:4px solid #9ab;background:#f6f8fa}"
+    "td.bad{background:#fde2e1;font-weight:600}td.partly{background:#fff4e5;font-weight:600}"
+    "td.good{background:#edf8f0}code{font-size:.92em;background:#f3f3f3;padding:0 .2em}"
 )
 
 
@@ -119,13 +123,18 @@ def _image_html(image: Image, report_dir: Path, embed: bool) -> str:
     return f'<figure><img alt="{alt}" src="{html.escape(src)}">{cap}</figure>'
 
 
+def warnings_html(warnings: Sequence[str], title: str = "Warnings") -> str:
+    """The highlighted box of a :class:`Section`'s ``warnings`` (text escaped), as HTML."""
+    items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings)
+    return (
+        f'<div class="warn" role="note"><strong>{html.escape(title)}</strong><ul>{items}</ul></div>'
+    )
+
+
 def _section_html(sec: Section, report_dir: Path, embed: bool) -> str:
     parts = []
     if sec.warnings:
-        items = "".join(f"<li>{html.escape(w)}</li>" for w in sec.warnings)
-        parts.append(
-            f'<div class="warn" role="note"><strong>Warnings</strong><ul>{items}</ul></div>'
-        )
+        parts.append(warnings_html(sec.warnings))
     if sec.text:
         parts += [f"<p>{html.escape(p.strip())}</p>" for p in sec.text.split("\n\n") if p.strip()]
     if sec.html:
@@ -136,6 +145,8 @@ def _section_html(sec: Section, report_dir: Path, embed: bool) -> str:
         parts.append(_table_html(sec.table))
     parts += [_image_html(img, report_dir, embed) for img in sec.images]
     heading = html.escape(sec.heading)
+    if not heading:  # an untitled section (e.g. an introduction under the title)
+        return f"<section>{''.join(parts)}</section>"
     if sec.collapsed:
         return f"<details><summary>{heading}</summary>{''.join(parts)}</details>"
     return f"<section><h2>{heading}</h2>{''.join(parts)}</section>"
