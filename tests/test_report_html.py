@@ -249,3 +249,22 @@ def test_identify_command_writes_a_report(tmp_path):
     order = [heading_index(page, h) for h in ("Result", "Order selection", "Measured", "Settings")]
     assert order == sorted(order)
     assert "(chosen)" in html_file.read_text()
+
+
+def test_warning_box_holds_problems_not_good_news():
+    """A model that describes its record gets an empty warning box; a poor one keeps its head."""
+    from scipy import signal
+
+    from clpc.report.parts import model_warnings
+
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(3000)
+    e = 0.05 * rng.standard_normal(3000)
+    y = signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u) + signal.lfilter(
+        [1.0], [1.0, -1.2, 0.5], e
+    )
+    good = clpc.ARX(order=2, nk=1).fit(u, y)
+    assert good.verdict().messages[0] == "the model describes the record"
+    assert model_warnings(good) == []
+    poor = clpc.ARX(order=1, nk=0).fit(u, y)
+    assert any("does NOT describe" in m or "carry the input" in m for m in model_warnings(poor))

@@ -104,6 +104,6 @@ def demo(
     click.echo(f"motor experiment finished{took}; results in {out_dir}")
     for claim in summary.get("claims") or []:
         click.echo(f"  {_claim_text(claim)}")
-    figures = summary.get("figures") or {}
     written = result.written
+    figures = [name for name in written if name.endswith(".png")]
     click.echo(f"wrote {len(written)} file(s) ({len(figures)} figure(s)): {', '.join(written)}")

@@ -19,7 +19,18 @@ from clpc.report.text import format_fit, format_model_summary
 __all__ = ["model_sections", "model_warnings", "settings_section"]
 
 #: verdict messages that are good news (everything else is shown as a warning)
-_GOOD = ("the data determine", "the model is stable", "no fit statistics")
+#: verdict messages that are evidence or good news, not warnings (kept out of the box)
+_GOOD = (
+    "the data determine",
+    "the model is stable",
+    "the model is integrating",
+    "the model describes the record",
+    "held-out fit (",
+    "residuals independent",
+    "residuals white",
+    "no fit statistics",
+    "no eigenvalue statistics",
+)
 
 
 def model_warnings(model: LinearModel) -> list[str]:

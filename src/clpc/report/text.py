@@ -74,7 +74,8 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
         ),
         f"inputs: {', '.join(summary['inputs'])}   outputs: {', '.join(summary['outputs'])}"
         + (f"   samples: {summary['n_samples']}" if "n_samples" in summary else ""),
-        "transfer functions G(z) = -B(z)/A(z), monic A, powers of z^-1:",
+        "transfer functions G(z) = numerator/A(z), monic A, powers of z^-1 "
+        "(numerator = -B(z) of the paper's theta = [a; b]):",
     ]
     for j, eq in enumerate(summary["equations"]):
         out = eq["output"]
