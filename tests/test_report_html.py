@@ -155,7 +155,12 @@ def test_track_report_warns_about_the_flagged_clusters(track_report):
     n = len(trace)
     determined = int(trace.arrays["determined"].all(axis=1).sum())
     assert determined < n  # the first windows are not full
-    assert f"{determined} of {n} clusters determine the parameters" in box
+    assert "the window does not determine the parameters in clusters 1" in box
+    # the count of good clusters is a warning only below the trusted fraction: here it is
+    # shown beside the table of the result, not in the box
+    assert determined >= 0.5 * n
+    assert f"{determined} of {n} clusters determine the parameters" not in box
+    assert f"{determined} of {n} clusters determine the parameters" in text
     assert "white-space:nowrap" in text  # CSS of the numeric cells
 
 
@@ -268,3 +273,34 @@ def test_warning_box_holds_problems_not_good_news():
     assert model_warnings(good) == []
     poor = clpc.ARX(order=1, nk=0).fit(u, y)
     assert any("does NOT describe" in m or "carry the input" in m for m in model_warnings(poor))
+
+
+def test_counts_of_good_clusters_warn_only_below_the_trusted_fraction():
+    from clpc.report.track import trace_warnings
+
+    summary = {
+        "convergence": {"converged": True},
+        "model_source": "steady state",
+        "findings": [
+            "82 of 83 clusters determine the parameters",
+            "30 of 83 clusters are trusted (only these are accepted)",
+        ],
+    }
+    assert trace_warnings(None, summary) == [  # type: ignore[arg-type]
+        "30 of 83 clusters are trusted (only these are accepted)"
+    ]
+
+
+def test_a_model_that_simulates_the_record_poorly_is_warned_about():
+    from scipy import signal
+
+    from clpc.report.parts import fit_warnings
+
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(2000)
+    y = signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u) + 0.02 * rng.standard_normal(2000)
+    data = clpc.IOData(u, y)
+    assert fit_warnings(clpc.ARX(order=2, nk=1).fit(data), data) == []
+    (warning,) = fit_warnings(clpc.ARX(order=1, nk=0).fit(data), data)
+    assert "(< 60 %): it does not describe the record well" in warning
+    assert fit_warnings(clpc.ARX(order=1).fit(data), None) == []

@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from clpc.core.rules import MIN_HELDOUT_FIT
 from clpc.model import LinearModel, fit_verdict
 from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
 from clpc.report.html import Section
@@ -44,6 +45,28 @@ def model_warnings(model: LinearModel) -> list[str]:
         for msg in fit_verdict(model, j).messages:
             if not msg.startswith(_GOOD):
                 out.append(msg if model.n_outputs == 1 else f"{name}: {msg}")
+    return out
+
+
+def fit_warnings(model: LinearModel, data: Any) -> list[str]:
+    """Outputs whose free-run fit on ``data`` is below :data:`clpc.core.rules.MIN_HELDOUT_FIT`.
+
+    The same threshold as the verdict's held-out fit: a model that simulates the record this
+    poorly does not describe it, whatever its eigenvalue structure says. Empty without data.
+    """
+    if data is None:
+        return []
+    fits = model_summary(model, data).get("fit", {}).get("simulation", [])
+    out = []
+    for name, fit in zip(model.output_names, fits, strict=False):
+        if not (isinstance(fit, (int, float)) and fit >= MIN_HELDOUT_FIT):
+            shown = f"{fit:.1f} %" if isinstance(fit, (int, float)) and fit == fit else "undefined"
+            who = "" if model.n_outputs == 1 else f"{name}: "
+            out.append(
+                f"{who}the model's free-run fit on the compared samples is {shown} "
+                f"(< {MIN_HELDOUT_FIT:g} %): it does not describe the record well - try "
+                "another order or input delay (clpc identify --estimator auto --nk auto)"
+            )
     return out
 
 

@@ -13,11 +13,12 @@ from os import PathLike
 from pathlib import Path
 from typing import Any
 
+from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
 from clpc.report.html import Section, write_html_report
-from clpc.report.parts import model_sections, model_warnings, settings_section
+from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import steady_state, trace_summary
 
 __all__ = ["trace_warnings", "write_track_report"]
@@ -38,8 +39,11 @@ def trace_warnings(trace: Trace, summary: Mapping[str, Any]) -> list[str]:
     Returns
     -------
     list of str
-        The findings of :func:`clpc.describe_trace` that report a problem (a cluster count
-        is one when not every cluster qualifies) and, when the trace did not converge, why.
+        The findings of :func:`clpc.describe_trace` that report a problem (a count of good
+        clusters is one when fewer than
+        :data:`~clpc.appraiser.convergence.MIN_TRUSTED_FRACTION` of the clusters qualify; the
+        clusters that fail are listed by their own findings) and, when the trace did not
+        converge, why.
     """
     out = []
     conv = summary["convergence"]
@@ -52,8 +56,8 @@ def trace_warnings(trace: Trace, summary: Mapping[str, Any]) -> list[str]:
         )
     for finding in summary["findings"]:
         counted = _COUNT.match(finding)
-        if counted and counted.group(1) == counted.group(2):
-            continue  # "249 of 249 clusters ...": all fine
+        if counted and int(counted.group(1)) >= MIN_TRUSTED_FRACTION * int(counted.group(2)):
+            continue  # "82 of 83 clusters ...": the clusters that fail are listed on their own
         out.append(finding)
     return out
 
@@ -128,6 +132,7 @@ def write_track_report(
     warnings = trace_warnings(trace, summary)
     if model is not None:
         warnings += model_warnings(model)
+        warnings += fit_warnings(model, data)
     findings = [f for f in summary["findings"] if f not in warnings]
     result = Section(
         "Result",
