@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
 from clpc.core.polynomials import pole_words
+from clpc.model.display import poly_text
 
 __all__ = ["estimator_name", "format_fit", "format_model_summary"]
 
@@ -19,21 +20,6 @@ _ESTIMATORS = {
     "clpc-steady-state": "CLPC",
     "multimodel-linearization": "multi-model linearization",
 }
-
-
-def _poly(coefs: Sequence[float], var: str = "z^-1") -> str:
-    terms = []
-    for i, c in enumerate(coefs):
-        if c == 0 and len(coefs) > 1:
-            continue
-        power = "" if i == 0 else (f" {var}" if i == 1 else f" {var[:-1]}{i}")
-        terms.append((c, f"{abs(c):.6g}{power}"))
-    if not terms:
-        return "0"
-    text = ("-" if terms[0][0] < 0 else "") + terms[0][1]
-    for c, t in terms[1:]:
-        text += (" - " if c < 0 else " + ") + t
-    return text
 
 
 def _fit_label(key: str) -> str:
@@ -79,9 +65,9 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
     ]
     for j, eq in enumerate(summary["equations"]):
         out = eq["output"]
-        lines.append(f"  [{out}]  A(z) = {_poly(eq['den'])}")
+        lines.append(f"  [{out}]  A(z) = {poly_text(eq['den'])}")
         for inp, num in eq["num"].items():
-            lines.append(f"  [{out}]  {inp} -> {out}:  numerator {_poly(num)}")
+            lines.append(f"  [{out}]  {inp} -> {out}:  numerator {poly_text(num)}")
         if eq["intercept"]:
             lines.append(f"  [{out}]  offset (intercept) {eq['intercept']:.6g}")
         poles = ", ".join(_fmt_complex(re, im) for re, im in eq["poles"])
