@@ -105,17 +105,18 @@ def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) ->
     ).read_bytes()
     print(f"\n## clpc track, end to end (subprocess wall time, best of {repeat}, alternating)")
     labels = {
-        "baseline": f"package at 64b4459 ({baseline_src})",
+        "baseline": f"baseline package ({baseline_src})",
         "plain": "plain path (CLPC_FAST_IO=0)",
         "default": "default",
     }
     for name, t in best.items():
         ratios = ", ".join(
-            f"{best[other] / t:.2f}x faster than {other}"
+            f"{name} is {best[other] / t:.2f}x as fast as {other}"
             for other in best
-            if other != name and best[other] > t
+            if other != name
         )
-        print(f"{labels[name]:<45} {t:6.2f} s   {ratios}")
+        median = float(np.median(times[name]))
+        print(f"{labels[name]:<45} {t:6.2f} s (median {median:.2f} s)   ({ratios})")
     every = "; ".join(f"{n}: " + " ".join(f"{x:.2f}" for x in t) for n, t in times.items())
     print(f"(every run [s]: {every})")
     print(
