@@ -6,15 +6,18 @@ Side by side in one run, each the best of ``--repeat`` (the two paths alternatin
   ``numpy.loadtxt`` in batches, Python for the messages) against the default path (pyarrow
   when installed); ``pandas.read_csv`` and ``pyarrow.csv.read_csv`` as outside references.
   The values must be identical.
-* ``python -m clpc track`` on the same file (subprocesses): ``CLPC_FAST_IO=0`` (plain reader
-  and the plain trace writer) against the default; the two ``trace.csv`` must hold the same
-  numbers. The phases of one in-process run are timed too (read, appraise, write the trace,
-  figures and report), to show where the time goes.
+* ``python -m clpc track`` on the same file (subprocesses, all variants alternating):
+  ``CLPC_FAST_IO=0`` (plain reader and the plain trace writer) against the default, and with
+  ``--baseline-src`` the package before issue 16 (commit 64b4459) as well; every
+  ``trace.csv`` must hold the same numbers. The phases of one in-process run are timed too
+  (read, appraise, write the trace, figures and report), to show where the time goes.
 * start-up: ``python -c "import clpc"``, ``clpc --help``, and the eager import of every
   exported name (what ``import clpc`` cost before the names were loaded lazily).
 
     python benchmarks/bench_io.py               # 1e6 rows
     python benchmarks/bench_io.py --rows 2e5    # quick
+    git worktree add /tmp/clpc-old 64b4459      # the package before issue 16, then:
+    python benchmarks/bench_io.py --baseline-src /tmp/clpc-old/src --skip-read --repeat 5
 """
 
 from __future__ import annotations
@@ -76,26 +79,53 @@ def bench_read(path: str, repeat: int) -> None:
     assert same, "the fast path changed the values"
 
 
-def bench_track(path: str, repeat: int, work: Path) -> None:
+def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) -> None:
     from clpc.io import read_table
 
     cmd = [sys.executable, "-m", "clpc", "track", path, "-u", "u", "-y", "y", "--out"]
-    env_plain = dict(os.environ, CLPC_FAST_IO="0")
-    run([*cmd, str(work / "warm")])  # the compiled kernel is loaded from numba's cache
-    plain, fast = [], []
-    for _ in range(repeat):
-        plain.append(run([*cmd, str(work / "plain")], env_plain))
-        fast.append(run([*cmd, str(work / "fast")]))
-    a = read_table(work / "plain" / "trace.csv")
-    b = read_table(work / "fast" / "trace.csv")
-    same = np.array_equal(a.data, b.data) and a.names == b.names
-    print(f"\n## clpc track, end to end (subprocess, best of {repeat})")
-    print(f"plain (CLPC_FAST_IO=0): {min(plain):.2f} s")
-    print(f"default:                {min(fast):.2f} s   -> {min(plain) / min(fast):.2f}x faster")
-    print(f"trace.csv identical numbers: {same} ({a.n_rows} updates)")
+    variants = {"plain": dict(os.environ, CLPC_FAST_IO="0"), "default": dict(os.environ)}
+    if baseline_src:  # the package before the work on issue 16 (commit 64b4459)
+        old_path = os.pathsep.join(filter(None, [baseline_src, os.environ.get("PYTHONPATH")]))
+        variants = {"baseline": dict(os.environ, PYTHONPATH=old_path), **variants}
+    for name, env in variants.items():  # compiled kernels loaded from numba's cache after this
+        run([*cmd, str(work / f"warm-{name}")], env)
+    times: dict[str, list[float]] = {name: [] for name in variants}
+    for _ in range(repeat):  # alternating, so that a busy spell of the machine hits all
+        for name, env in variants.items():
+            times[name].append(run([*cmd, str(work / name)], env))
+    best = {name: min(t) for name, t in times.items()}
+    traces = {name: read_table(work / name / "trace.csv") for name in variants}
+    ref = traces["default"]
+    same = {
+        name: np.array_equal(t.data, ref.data) and t.names == ref.names
+        for name, t in traces.items()
+    }
+    same_bytes = (work / "plain" / "trace.csv").read_bytes() == (
+        work / "default" / "trace.csv"
+    ).read_bytes()
+    print(f"\n## clpc track, end to end (subprocess wall time, best of {repeat}, alternating)")
+    labels = {
+        "baseline": f"baseline package ({baseline_src})",
+        "plain": "plain path (CLPC_FAST_IO=0)",
+        "default": "default",
+    }
+    for name, t in best.items():
+        ratios = ", ".join(
+            f"{name} is {best[other] / t:.2f}x as fast as {other}"
+            for other in best
+            if other != name
+        )
+        median = float(np.median(times[name]))
+        print(f"{labels[name]:<45} {t:6.2f} s (median {median:.2f} s)   ({ratios})")
+    every = "; ".join(f"{n}: " + " ".join(f"{x:.2f}" for x in t) for n, t in times.items())
+    print(f"(every run [s]: {every})")
+    print(
+        f"trace.csv: same numbers as the default: {same} ({ref.n_rows} updates); plain and "
+        f"default byte-identical: {same_bytes}"
+    )
     for label, env in (("plain", "0"), ("default", "1")):
         print(f"phases ({label}): {phases(path, work / f'phases-{label}', env)}")
-    assert same, "the fast path changed the trace"
+    assert all(same.values()), "a path changed the trace"
 
 
 def phases(path: str, out: Path, fast_io: str) -> str:
@@ -148,6 +178,13 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--rows", type=float, default=1e6)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument(
+        "--baseline-src",
+        help="src folder of the package at commit 64b4459 (before issue 16), e.g. "
+        "/tmp/clpc-old/src after `git worktree add /tmp/clpc-old 64b4459`; its `clpc track` "
+        "is timed beside the others (PYTHONPATH of the subprocess)",
+    )
+    ap.add_argument("--skip-read", action="store_true", help="only `clpc track` and start-up")
     args = ap.parse_args()
     import clpc
 
@@ -161,8 +198,9 @@ def main() -> None:
         work = Path(tmp)
         path = str(work / "record.csv")
         write_record(path, int(args.rows))
-        bench_read(path, args.repeat)
-        bench_track(path, args.repeat, work)
+        if not args.skip_read:
+            bench_read(path, args.repeat)
+        bench_track(path, args.repeat, work, args.baseline_src)
     bench_startup(5 * args.repeat)
 
 

@@ -12,7 +12,6 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from scipy import signal
 
 from clpc.data import as_iodata
 from clpc.lpc import assessment
@@ -125,6 +124,8 @@ def simulate_arx(den: Any, num: Any, u: Any, noise: Any | None = None) -> np.nda
     -------
     ndarray, shape (T,)
     """
+    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
     y = signal.lfilter(np.asarray(num, float), np.asarray(den, float), np.asarray(u, float))
     if noise is not None:
         y = y + signal.lfilter([1.0], np.asarray(den, float), np.asarray(noise, float))

@@ -29,7 +29,6 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from scipy import optimize, signal
 
 from clpc.data import DataError, IOData, as_iodata
 from clpc.lpc import assessment
@@ -68,6 +67,8 @@ class _Problem:
         a, _, b, k = self.split(x)
         forced = self.phi_u @ b + k
         past = self.y[self.s - self.na : self.s][::-1]  # y(s-1), y(s-2), ..., y(s-na)
+        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
         zi = signal.lfiltic([1.0], a, past)
         return a, signal.lfilter([1.0], a, forced, zi=zi)[0]
 
@@ -81,6 +82,8 @@ class _Problem:
         full = np.concatenate([self.y[: self.s], y_hat])
         y_lags = lagged(full, self.na - 1, 1, self.s)  # y_hat(n-1) .. y_hat(n-na)
         cols = np.hstack([-y_lags, self.phi_u, np.ones((y_hat.size, 1))])
+        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
         return -signal.lfilter([1.0], a, cols, axis=0)  # -(d y_hat / d (a, b, k))
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
@@ -102,6 +105,8 @@ class _Problem:
         # the simulation starts from the measured (noisy) y(s-1..s-na): their noise, white
         # like the output's, moves the estimate by -(J^T J)^-1 J^T G delta (G: the free
         # response to each start value), which the sandwich adds.
+        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
         a, zeros = self.split(x)[0], np.zeros(res.size)
         g = np.column_stack(
             [
@@ -224,6 +229,8 @@ class OE:
             fits = {}
             for name, model in starts.items():
                 x0 = _start_vector(model, j, list(cols), structure)
+                from scipy import optimize  # imported when used (as scipy.signal: ~0.8 s)
+
                 res = optimize.least_squares(
                     prob.residual,
                     x0,

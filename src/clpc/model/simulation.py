@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy import signal
 
 from clpc.model.errors import ModelError, as_2d
 
@@ -57,6 +56,8 @@ def forced(model: Any, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
         if u0.shape[0] < n_lag:
             raise ValueError(f"u_init must hold the last {n_lag} inputs before u[0].")
         u_ext = np.vstack([u0[u0.shape[0] - n_lag :], u])
+    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
     x = np.empty((u.shape[0], model.n_outputs))
     for j in range(model.n_outputs):
         acc = np.zeros(u_ext.shape[0])
@@ -88,6 +89,8 @@ def simulate(
             raise ValueError(f"y_init must hold the last {na} outputs before u[0].")
         y0 = y0[y0.shape[0] - na :]
     y = np.empty_like(x)
+    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
     for j in range(model.n_outputs):
         zi = None
         if y0 is not None:
@@ -175,6 +178,8 @@ def infer_input(
             )
         past = past[past.size - s.na :]
     y_ext = np.concatenate([past, yv])
+    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
+
     w = signal.lfilter(model.den, [1.0], y_ext)[s.na :] - model.intercept[0]
     u_hat = signal.lfilter([1.0], num, w)
     return u_hat[s.nk :] if s.nk else u_hat

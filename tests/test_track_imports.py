@@ -1,0 +1,56 @@
+"""`clpc track`'s start-up: heavy modules are imported only where they are used (issue 16).
+
+Each check runs in a fresh interpreter (a subprocess), since this test session has long
+imported everything.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+
+def _modules_after(code: str) -> set[str]:
+    """The top modules of interest imported after running ``code`` in a fresh interpreter."""
+    probe = textwrap.dedent(code) + textwrap.dedent(
+        """
+        import sys
+        print(" ".join(m for m in ("scipy.signal", "scipy.optimize", "matplotlib", "pandas")
+                       if m in sys.modules))
+        """
+    )
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return set(res.stdout.split())
+
+
+def test_the_track_command_imports_neither_scipy_signal_nor_matplotlib():
+    loaded = _modules_after("import clpc.cli.track, clpc.workflows.track, clpc.appraiser")
+    assert not loaded & {"scipy.signal", "scipy.optimize", "matplotlib"}, loaded
+
+
+def test_the_fast_reader_and_trace_writer_do_not_import_pandas(tmp_path):
+    pytest.importorskip("pyarrow")
+    pytest.importorskip("pandas")  # the point: pyarrow's to_numpy / pa.array would load it
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(600)
+    y = np.convolve(u, [0.0, 0.5, 0.2])[:600] + 0.01 * rng.standard_normal(600)
+    path = tmp_path / "rec.csv"
+    np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
+    out = tmp_path / "trace.csv"
+    loaded = _modules_after(
+        f"""
+        from clpc.io import iter_table_chunks
+        from clpc.appraiser import CLPC
+        from clpc.appraiser.tracefile import TraceWriter
+        a = CLPC(order=1, window_size=40, cluster_size=5)
+        with TraceWriter({str(out)!r}) as w:
+            for _, v in iter_table_chunks({str(path)!r}, 250, columns=["u", "y"]):
+                w.write(a.push(v[:, :1], v[:, 1:]))
+        """
+    )
+    assert "pandas" not in loaded
+    assert out.read_text().count("\n") > 10  # the trace was written
