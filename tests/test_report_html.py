@@ -300,7 +300,8 @@ def test_a_model_that_simulates_the_record_poorly_is_warned_about():
     u = rng.standard_normal(2000)
     y = signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u) + 0.02 * rng.standard_normal(2000)
     data = clpc.IOData(u, y)
-    assert fit_warnings(clpc.ARX(order=2, nk=1).fit(data), data) == []
-    (warning,) = fit_warnings(clpc.ARX(order=1, nk=0).fit(data), data)
+    good, poor = clpc.ARX(order=2, nk=1).fit(data), clpc.ARX(order=1, nk=0).fit(data)
+    assert fit_warnings(good, report.model_summary(good, data)) == []
+    (warning,) = fit_warnings(poor, report.model_summary(poor, data))
     assert "(< 60 %): it does not describe the record well" in warning
-    assert fit_warnings(clpc.ARX(order=1).fit(data), None) == []
+    assert fit_warnings(poor, report.model_summary(poor)) == []  # no data: no fit to judge

@@ -160,7 +160,8 @@ def operating_point_diagnostics(
     if uu.shape != yy.shape:
         raise ValueError(f"u and y must have the same length; got {uu.size} and {yy.size}.")
     s = trace.structure
-    ref = reference or ARX(na=s.na, nb=s.nb, nk=s.nk).fit(uu, yy, dt=trace.sample_time)
+    lean = ARX(na=s.na, nb=s.nb, nk=s.nk, uncertainty=False, assess=False)  # residuals only
+    ref = reference or lean.fit(uu, yy, dt=trace.sample_time)
     ops = window_means(yy, trace.index, trace.rows)
     err2 = _one_step_error(ref, uu, yy) ** 2
     ref_rms = np.sqrt(np.maximum(window_means(err2, trace.index, trace.rows), 0.0))

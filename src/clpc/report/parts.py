@@ -48,15 +48,20 @@ def model_warnings(model: LinearModel) -> list[str]:
     return out
 
 
-def fit_warnings(model: LinearModel, data: Any) -> list[str]:
-    """Outputs whose free-run fit on ``data`` is below :data:`clpc.core.rules.MIN_HELDOUT_FIT`.
+def fit_warnings(model: LinearModel, summary: Mapping[str, Any]) -> list[str]:
+    """Outputs whose free-run fit is below :data:`clpc.core.rules.MIN_HELDOUT_FIT`.
 
     The same threshold as the verdict's held-out fit: a model that simulates the record this
-    poorly does not describe it, whatever its eigenvalue structure says. Empty without data.
+    poorly does not describe it, whatever its eigenvalue structure says.
+
+    Parameters
+    ----------
+    model : LinearModel
+    summary : mapping
+        :func:`model_summary` of ``model`` on the compared record (none without its
+        ``"fit"`` entry, i.e. without data).
     """
-    if data is None:
-        return []
-    fits = model_summary(model, data).get("fit", {}).get("simulation", [])
+    fits = summary.get("fit", {}).get("simulation", [])
     out = []
     for name, fit in zip(model.output_names, fits, strict=False):
         if not (isinstance(fit, (int, float)) and fit >= MIN_HELDOUT_FIT):
@@ -88,6 +93,7 @@ def model_sections(
     data: Any = None,
     data_note: str = "",
     data_t0: float = 0.0,
+    summary: Mapping[str, Any] | None = None,
 ) -> tuple[list[Section], list[Path]]:
     """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
 
@@ -103,6 +109,8 @@ def model_sections(
         Where the compared samples come from (shown under the fit figure).
     data_t0 : float
         Time of ``data``'s first sample in the whole record (the fit figure's time axis).
+    summary : mapping, optional
+        :func:`model_summary` of ``model`` on ``data``, when the caller has it already.
 
     Returns
     -------
@@ -110,7 +118,7 @@ def model_sections(
     files : list of Path
         The figures written.
     """
-    summary = model_summary(model, data)
+    summary = model_summary(model, data) if summary is None else summary
     files: list[Path] = []
     sections = [
         Section(

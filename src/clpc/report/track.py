@@ -19,7 +19,7 @@ from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
-from clpc.report.summaries import steady_state, trace_summary
+from clpc.report.summaries import model_summary, steady_state, trace_summary
 
 __all__ = ["trace_warnings", "write_track_report"]
 
@@ -132,7 +132,8 @@ def write_track_report(
     warnings = trace_warnings(trace, summary)
     if model is not None:
         warnings += model_warnings(model)
-        warnings += fit_warnings(model, data)
+        fitted = model_summary(model, data)
+        warnings += fit_warnings(model, fitted)
     findings = [f for f in summary["findings"] if f not in warnings]
     result = Section(
         "Result",
@@ -143,7 +144,9 @@ def write_track_report(
     sections = [result]
     files: list[Path] = []
     if model is not None:
-        more, files = model_sections(model, out, data=data, data_note=data_note, data_t0=data_t0)
+        more, files = model_sections(
+            model, out, data=data, data_note=data_note, data_t0=data_t0, summary=fitted
+        )
         more[0].heading = f"Model: {source}"
         sections += more
     else:
