@@ -1,6 +1,6 @@
 """``python -m clpc``: the same command line as the ``clpc`` console script."""
 
-from clpc.cli import main
+from clpc.cli import run
 
 if __name__ == "__main__":
-    main()
+    run()

@@ -9,6 +9,8 @@ for figures and summaries (every update until the cap, then every 2nd, 4th, ... 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -116,6 +118,9 @@ class TraceWriter:
         self._names: list[str] | None = None
         self._row_format = ""
         self._pa: Any = None
+        self._csv_options: Any = None
+        self._pool: ThreadPoolExecutor | None = None
+        self._pending: Future[Any] | None = None
         self.rows = 0
 
     def write(self, part: Trace) -> None:
@@ -132,7 +137,7 @@ class TraceWriter:
         elif self._pa is not None:
             pa = self._pa
             table = _arrow_table(pa, [f"c{i}" for i in range(len(cols))], cols)
-            pa.csv.write_csv(table, self._fh, pa.csv.WriteOptions(include_header=False))
+            self._in_background(pa.csv.write_csv, table, self._fh, self._csv_options)
         else:
             rows = np.column_stack([c.astype(object) for c in cols]).tolist()
             fmt = self._row_format
@@ -147,6 +152,7 @@ class TraceWriter:
             if self._pa is not None:
                 self._fh = self.path.open("wb")
                 self._fh.write(header)
+                self._csv_options = self._pa.csv.WriteOptions(include_header=False)
             else:
                 self._fh = self.path.open("w", encoding="utf-8")
                 self._fh.write(header.decode())
@@ -167,8 +173,30 @@ class TraceWriter:
         )
         self._writer = pq.ParquetWriter(self.path, schema)
 
+    def _in_background(self, fn: Callable[..., Any], *args: Any) -> None:
+        """Run ``fn(*args)`` in a thread, after the writes before it.
+
+        pyarrow's CSV writer releases the GIL: the rows are formatted while the appraiser
+        computes the next chunk. The error of an earlier write is raised here.
+        """
+        if self._pending is not None:
+            self._pending.result()
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="clpc-trace")
+        self._pending = self._pool.submit(fn, *args)
+
     def close(self) -> None:
-        """Flush and close the file."""
+        """Finish the writes, flush and close the file (an error of a write is raised)."""
+        pending, self._pending = self._pending, None
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+        if pending is not None and pending.exception() is not None:
+            self._close_files()
+            raise pending.exception()  # type: ignore[misc]
+        self._close_files()
+
+    def _close_files(self) -> None:
         if self._fh is not None:
             self._fh.close()
             self._fh = None

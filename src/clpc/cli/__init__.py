@@ -7,11 +7,12 @@ chunks), ``stream`` (the appraiser on standard input, one JSON line per update),
 Exit codes: 0 success, 1 a data or model error (one line on standard error, no traceback),
 2 a usage error (unknown option, bad option value); see :mod:`clpc.cli.errors`.
 
-Modules: ``app`` (the group, ``main``), ``errors``, ``options`` (shared options),
-``output`` (JSON and CSV printing), one module per command group: ``identify``, ``track``,
-``stream``, ``models`` (simulate, compare), ``info`` (datasets, demo).
+Modules: ``app`` (the group, ``main``, the process entry ``run``), ``errors``, ``options``
+(shared options), ``output`` (JSON and CSV printing), one module per command group:
+``identify``, ``track``, ``stream``, ``models`` (simulate, compare), ``info`` (datasets,
+demo).
 """
 
-from clpc.cli.app import cli, main
+from clpc.cli.app import cli, main, run
 
-__all__ = ["cli", "main"]
+__all__ = ["cli", "main", "run"]

@@ -5,7 +5,8 @@ alike. matplotlib is imported only when a figure is made (``pip install 'clpc[pl
 
 * :data:`COLORS` - one colour per quantity (measured, model output, residual, ...), the
   same in every figure.
-* :func:`new_figure` / :func:`axes_for` - a headless figure, or the caller's axes.
+* :func:`new_figure` / :func:`axes_for` - a headless figure, or the caller's axes;
+  :class:`Margins` - fixed margins for a figure whose labels are known in advance.
 * :func:`envelope` - min/max of a long signal over bins (vectorised), for drawing.
 * :func:`draw_signal` - a line, or its min/max band when there are too many points.
 * :func:`time_label` / :func:`place_legend`.
@@ -14,6 +15,7 @@ alike. matplotlib is imported only when a figure is made (``pip install 'clpc[pl
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -23,6 +25,7 @@ import numpy as np
 __all__ = [
     "COLORS",
     "MAX_POINTS",
+    "Margins",
     "axes_for",
     "draw_signal",
     "envelope",
@@ -53,16 +56,69 @@ COLORS: dict[str, str] = {
 MAX_POINTS = 4000
 
 
-def new_figure(n_rows: int = 1, n_cols: int = 1, *, height: float = 2.6, width: float = 8.0):
-    """A new Agg-backed figure (no pyplot state) and its axes, shape (n_rows, n_cols)."""
+def new_figure(
+    n_rows: int = 1,
+    n_cols: int = 1,
+    *,
+    height: float = 2.6,
+    width: float = 8.0,
+    margins: Margins | None = None,
+):
+    """A new Agg-backed figure (no pyplot state) and its axes, shape (n_rows, n_cols).
+
+    Parameters
+    ----------
+    n_rows, n_cols : int
+        Axes grid.
+    height, width : float
+        Height per row and width of the figure [in] (0.7 in more for the title).
+    margins : Margins, optional
+        Fixed margins and gaps; by default matplotlib's constrained layout places the axes
+        (it measures every tick label, about a third of a figure's drawing time).
+    """
     try:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
     except ImportError:  # pragma: no cover - depends on the environment
         raise ImportError(INSTALL_HINT) from None
-    fig = Figure(figsize=(width, 0.7 + height * n_rows), layout="constrained")
+    size = (width, 0.7 + height * n_rows)
+    fig = Figure(figsize=size, layout="constrained" if margins is None else None)
     FigureCanvasAgg(fig)
-    return fig, fig.subplots(n_rows, n_cols, squeeze=False)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    if margins is not None:
+        margins.apply(fig, n_rows, n_cols)
+    return fig, axes
+
+
+@dataclass(frozen=True)
+class Margins:
+    """Fixed figure margins and gaps between axes [in], for figures of a known layout.
+
+    A figure whose labels are known in advance (e.g. :func:`clpc.plotting.plot_trace`)
+    is placed by these instead of the constrained layout, which costs a third of its
+    drawing time.
+    """
+
+    left: float = 0.95
+    right: float = 0.2
+    top: float = 0.75
+    bottom: float = 0.55
+    row_gap: float = 0.7
+    col_gap: float = 0.95
+
+    def apply(self, fig: Any, n_rows: int, n_cols: int) -> None:
+        """Place ``fig``'s grid of ``n_rows`` x ``n_cols`` axes."""
+        w, h = fig.get_size_inches()
+        axes_h = (h - self.top - self.bottom - (n_rows - 1) * self.row_gap) / n_rows
+        axes_w = (w - self.left - self.right - (n_cols - 1) * self.col_gap) / n_cols
+        fig.subplots_adjust(
+            left=self.left / w,
+            right=1.0 - self.right / w,
+            top=1.0 - self.top / h,
+            bottom=self.bottom / h,
+            hspace=self.row_gap / max(axes_h, 1e-3),
+            wspace=self.col_gap / max(axes_w, 1e-3),
+        )
 
 
 def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tuple[Any, list]:

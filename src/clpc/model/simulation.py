@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.filters import all_pole, fir
 from clpc.model.errors import ModelError, as_2d
 
 __all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
@@ -56,13 +57,11 @@ def forced(model: Any, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
         if u0.shape[0] < n_lag:
             raise ValueError(f"u_init must hold the last {n_lag} inputs before u[0].")
         u_ext = np.vstack([u0[u0.shape[0] - n_lag :], u])
-    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
     x = np.empty((u.shape[0], model.n_outputs))
     for j in range(model.n_outputs):
         acc = np.zeros(u_ext.shape[0])
         for i in range(model.n_inputs):
-            acc += signal.lfilter(nums[j, i], [1.0], u_ext[:, i])
+            acc += fir(nums[j, i], u_ext[:, i])
         x[:, j] = acc[n_lag:]
     return x
 
@@ -89,16 +88,8 @@ def simulate(
             raise ValueError(f"y_init must hold the last {na} outputs before u[0].")
         y0 = y0[y0.shape[0] - na :]
     y = np.empty_like(x)
-    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
     for j in range(model.n_outputs):
-        zi = None
-        if y0 is not None:
-            zi = signal.lfiltic([1.0], dens[j], y0[::-1, j])
-        if zi is None:
-            y[:, j] = signal.lfilter([1.0], dens[j], x[:, j])
-        else:
-            y[:, j] = signal.lfilter([1.0], dens[j], x[:, j], zi=zi)[0]
+        y[:, j] = all_pole(dens[j], x[:, j], None if y0 is None else y0[::-1, j])
     return y[:, 0] if (was_1d and model.n_outputs == 1) else y
 
 

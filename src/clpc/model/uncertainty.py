@@ -81,10 +81,11 @@ def _dof(model: Any) -> np.ndarray:
 def _quantile(level: float, dof: np.ndarray) -> np.ndarray:
     if not 0.0 < level < 1.0:
         raise ValueError(f"level must be in (0, 1), e.g. 0.95; got {level!r}.")
-    from scipy import stats  # scipy.stats costs ~0.5 s to import: only where it is used
+    from scipy import special  # not scipy.stats, which costs 0.4 s to import
 
-    tail = 0.5 + 0.5 * level
-    return np.where(np.isfinite(dof), stats.t.ppf(tail, np.maximum(dof, 1.0)), stats.norm.ppf(tail))
+    tail = 0.5 + 0.5 * level  # Student's t quantile, the normal one for infinite dof
+    student = special.stdtrit(np.maximum(dof, 1.0), tail)
+    return np.where(np.isfinite(dof), student, special.ndtri(tail))
 
 
 def _shape(model: Any, arr: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ import numpy as np
 from clpc.core.figure import (
     COLORS,
     MAX_POINTS,
+    Margins,
     axes_for,
     draw_signal,
     new_figure,
@@ -22,6 +23,11 @@ __all__ = ["plot_trace", "trace_panels"]
 
 #: flagged updates are drawn one marker each up to this count, else as shaded bins
 MAX_MARKERS = 300
+
+#: the figure's labels are known (one-line y labels, numbers of at most 7 characters, a
+#: legend above D only): fixed margins place it, at two thirds of the constrained layout's
+#: drawing time
+_MARGINS = Margins(left=0.95, right=0.25, top=0.62, bottom=0.55, row_gap=0.66, col_gap=1.2)
 
 
 def trace_panels(trace: Any) -> int:
@@ -92,7 +98,7 @@ def plot_trace(
     n_eq, p = trace.n_equations, len(labels)
     if ax is None:
         n_rows = -(-p // 2)
-        fig, grid = new_figure(n_eq * (1 + n_rows), 2, height=1.7)
+        fig, grid = new_figure(n_eq * (1 + n_rows), 2, height=1.7, margins=_MARGINS)
         axes = []
         for e in range(n_eq):
             top = e * (1 + n_rows)
@@ -137,7 +143,7 @@ def plot_trace(
             draw_signal(axp, t, np.where(has, theta[:, i], np.nan), color=COLORS["theta"])
             axp.set_ylabel(f"{lab} [-]" if n_eq == 1 else f"{lab} ({name}) [-]")
             axp.set_xlabel(xlabel)
-            axp.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useOffset=False)
+            axp.ticklabel_format(axis="both", style="sci", scilimits=(-3, 4), useOffset=False)
             if t.size > 1:
                 axp.set_xlim(t[0], t[-1])
             if not has.any():
@@ -148,6 +154,9 @@ def plot_trace(
     heading = title or f"CLPC trace: {len(trace)} updates"
     if len(trace) > MAX_POINTS:
         heading += " (min/max envelopes)"
-    fig.suptitle(heading)
+    if ax is None:  # fixed margins: the title 0.1 in below the top edge, above the legend
+        fig.suptitle(heading, y=1.0 - 0.1 / fig.get_figheight(), va="top")
+    else:
+        fig.suptitle(heading)
     save_figure(fig, path)
     return fig

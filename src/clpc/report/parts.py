@@ -14,10 +14,11 @@ from clpc.core.rules import MIN_HELDOUT_FIT
 from clpc.model import LinearModel, fit_verdict
 from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
 from clpc.report.html import Section
+from clpc.report.painter import FigureJob, draw_here
 from clpc.report.summaries import model_summary
 from clpc.report.text import format_fit, format_model_summary
 
-__all__ = ["model_sections", "model_warnings", "settings_section"]
+__all__ = ["model_figures", "model_sections", "model_warnings", "settings_section"]
 
 #: verdict messages that are good news (everything else is shown as a warning)
 #: verdict messages that are evidence or good news, not warnings (kept out of the box)
@@ -86,6 +87,34 @@ def fit_table(summary: Mapping[str, Any]) -> list[list[Any]]:
     return rows
 
 
+#: the figures of :func:`model_sections`, in its order
+FIT_PNG, DATA_PNG, STEP_PNG = "fit.png", "data.png", "step.png"
+BODE_PNG, PZ_PNG = "bode.png", "pz.png"
+
+
+def model_figures(
+    model: LinearModel, out: Path, *, data: Any = None, data_t0: float = 0.0
+) -> list[FigureJob]:
+    """The figures of :func:`model_sections`, as jobs (for :class:`~clpc.report.painter.Painter`).
+
+    ``fit.png`` and ``data.png`` (with ``data``), ``step.png``, ``bode.png``, ``pz.png`` in
+    ``out``; ``cost`` is each one's relative drawing time.
+    """
+    jobs: list[FigureJob] = []
+    if data is not None:
+        title = f"the compared {data.n_samples} samples"
+        jobs += [
+            FigureJob(plot_fit, (model, data, out / FIT_PNG), {"t0": data_t0}, cost=1.0),
+            FigureJob(plot_data, (data, out / DATA_PNG), {"t0": data_t0, "title": title}, 0.8),
+        ]
+    jobs += [
+        FigureJob(plot_step, (model, out / STEP_PNG), cost=0.5),
+        FigureJob(plot_bode, (model, out / BODE_PNG), cost=1.5),
+        FigureJob(plot_pz, (model, out / PZ_PNG), cost=0.5),
+    ]
+    return jobs
+
+
 def model_sections(
     model: LinearModel,
     out: Path,
@@ -94,6 +123,7 @@ def model_sections(
     data_note: str = "",
     data_t0: float = 0.0,
     summary: Mapping[str, Any] | None = None,
+    draw: bool = True,
 ) -> tuple[list[Section], list[Path]]:
     """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
 
@@ -111,12 +141,15 @@ def model_sections(
         Time of ``data``'s first sample in the whole record (the fit figure's time axis).
     summary : mapping, optional
         :func:`model_summary` of ``model`` on ``data``, when the caller has it already.
+    draw : bool
+        Draw the figures here; ``False`` when the caller draws :func:`model_figures`
+        itself (e.g. in forked processes).
 
     Returns
     -------
     sections : list of Section
     files : list of Path
-        The figures written.
+        The figures (written when ``draw``).
     """
     summary = model_summary(model, data) if summary is None else summary
     files: list[Path] = []
@@ -128,9 +161,7 @@ def model_sections(
         )
     ]
     if data is not None:
-        fit_png, data_png = out / "fit.png", out / "data.png"
-        plot_fit(model, data, fit_png, t0=data_t0)
-        plot_data(data, data_png, t0=data_t0, title=f"the compared {data.n_samples} samples")
+        fit_png, data_png = out / FIT_PNG, out / DATA_PNG
         files += [fit_png, data_png]
         sections.append(
             Section(
@@ -142,10 +173,7 @@ def model_sections(
                 ],
             )
         )
-    step_png, bode_png, pz_png = out / "step.png", out / "bode.png", out / "pz.png"
-    plot_step(model, step_png)
-    plot_bode(model, bode_png)
-    plot_pz(model, pz_png)
+    step_png, bode_png, pz_png = out / STEP_PNG, out / BODE_PNG, out / PZ_PNG
     files += [step_png, bode_png, pz_png]
     sections.append(
         Section(
@@ -166,6 +194,8 @@ def model_sections(
             collapsed=True,
         )
     )
+    if draw:
+        draw_here(model_figures(model, out, data=data, data_t0=data_t0))
     return sections, files
 
 

@@ -18,7 +18,14 @@ from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
 from clpc.report.html import Section, write_html_report
-from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
+from clpc.report.painter import FigureJob, Painter
+from clpc.report.parts import (
+    fit_warnings,
+    model_figures,
+    model_sections,
+    model_warnings,
+    settings_section,
+)
 from clpc.report.summaries import model_summary, steady_state, trace_summary
 
 __all__ = ["trace_warnings", "write_track_report"]
@@ -92,6 +99,7 @@ def write_track_report(
     data_t0: float = 0.0,
     steady: tuple[Any, str] | None = None,
     recent: Trace | None = None,
+    painter: Painter | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -120,6 +128,9 @@ def write_track_report(
         (computed from ``trace`` when omitted).
     recent : Trace, optional
         The last updates, unthinned, for the table of the last 20 (default ``trace``).
+    painter : Painter, optional
+        Draws the figures (e.g. in forked processes, :class:`~clpc.report.painter.Painter`);
+        by default they are drawn here, one by one.
 
     Returns
     -------
@@ -127,8 +138,14 @@ def write_track_report(
         The files written (the report last).
     """
     out = Path(out_dir)
-    summary = trace_summary(trace) if summary is None else summary
     model, source = steady_state(trace) if steady is None else steady
+    trace_png = out / "trace.png"
+    jobs = [] if model is None else model_figures(model, out, data=data, data_t0=data_t0)
+    title_png = f"CLPC trace: {len(trace)} updates"
+    jobs.append(FigureJob(plot_trace, (trace, trace_png), {"title": title_png}, cost=2.0))
+    painter = Painter(enabled=False) if painter is None else painter
+    painter.submit(jobs)  # drawn meanwhile when the painter forked, else by wait() below
+    summary = trace_summary(trace) if summary is None else summary
     warnings = trace_warnings(trace, summary)
     if model is not None:
         warnings += model_warnings(model)
@@ -145,14 +162,18 @@ def write_track_report(
     files: list[Path] = []
     if model is not None:
         more, files = model_sections(
-            model, out, data=data, data_note=data_note, data_t0=data_t0, summary=fitted
+            model,
+            out,
+            data=data,
+            data_note=data_note,
+            data_t0=data_t0,
+            summary=fitted,
+            draw=False,
         )
         more[0].heading = f"Model: {source}"
         sections += more
     else:
         result.text = "The figure of the trace below shows why no estimate was accepted."
-    trace_png = out / "trace.png"
-    plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     files.append(trace_png)
     sections.append(
         Section(
@@ -171,5 +192,6 @@ def write_track_report(
     rows += [[row[i] for i in keep] for row in values[-20:]]
     sections.append(Section(f"Last {len(rows) - 1} updates", table=rows, collapsed=True))
     sections.append(settings_section(settings or {}))
+    painter.wait()
     files.append(write_html_report(out / "report.html", title, sections))
     return files

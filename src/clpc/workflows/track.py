@@ -24,6 +24,7 @@ from clpc.io import iter_table_chunks, save_model
 from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
+from clpc.report.painter import Painter
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
@@ -268,8 +269,17 @@ class _Run:
     whole: _SummaryTrace = field(default_factory=_SummaryTrace)
 
 
-def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
-    """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``."""
+def _appraise(
+    settings: TrackSettings,
+    trace_file: Path,
+    progress: ChunkFilter | None,
+    after_first: Callable[[], None] | None = None,
+) -> _Run:
+    """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``.
+
+    ``after_first`` is called once the first chunk is appraised (the compiled kernels are
+    loaded then).
+    """
     record = settings.record
     n_in, n_out = len(record.inputs), len(record.outputs)
     clock = _Clock(record) if record.time_col else None
@@ -302,6 +312,9 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                 writer.write(part)
                 run.kept.add(part)
                 run.whole.add(part)
+            if after_first is not None:
+                after_first()
+                after_first = None
     assert run is not None  # iter_table_chunks raises on a file without rows
     return run
 
@@ -349,9 +362,10 @@ def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
     return {"data": data, "data_note": note, "data_t0": t0}
 
 
-#: the report's heavy imports (about 1.2 s together), loaded while the record is read and
-#: appraised: pyarrow's reader and the compiled kernel run without holding the GIL
-_REPORT_MODULES = ("scipy.signal", "matplotlib.figure", "matplotlib.backends.backend_agg")
+#: the report's heavy imports (matplotlib, about 0.5 s), loaded in a thread while the record
+#: is read and appraised when no painter process does it: pyarrow's reader, the trace
+#: writer and the compiled kernel run without holding the GIL
+_REPORT_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 
 
 def _import_quietly(names: tuple[str, ...]) -> None:
@@ -370,7 +384,9 @@ def _prefetch(names: tuple[str, ...]) -> threading.Thread:
     return thread
 
 
-def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
+def track_file(
+    settings: TrackSettings, progress: ChunkFilter | None = None, *, fork_figures: bool = False
+) -> TrackResult:
     """Run the CLPC appraiser over a record (read in chunks); write a trace and a report.
 
     Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
@@ -386,6 +402,10 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     progress : callable, optional
         Wraps the iterator of chunks ``(names, values)`` read from the file (once the file
         is open) and yields them on, e.g. to show a progress bar.
+    fork_figures : bool
+        Draw the report's figures in forked processes (:class:`clpc.report.painter.Painter`,
+        POSIX; ``CLPC_PAINTER=0`` turns it off): one imports matplotlib while the record is
+        appraised, then two draw on the machine's cores. ``clpc track`` does.
 
     Returns
     -------
@@ -407,11 +427,20 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         )
     out = Path(settings.out_dir)
     trace_file = out / f"trace.{settings.fmt}"
-    prefetch = _prefetch(_REPORT_MODULES)
-    try:
-        run = _appraise(settings, trace_file, progress)
-    finally:
-        prefetch.join()  # no import of the same modules from two threads at once
+    with Painter(enabled=None if fork_figures else False) as painter:
+        # forked after the first chunk, the painter imports matplotlib meanwhile; without it,
+        # a thread does (and both import numba while the first chunk is read)
+        prefetch = _prefetch(("numba",) if painter.enabled else ("numba", *_REPORT_MODULES))
+        try:
+            run = _appraise(settings, trace_file, progress, painter.start)
+        finally:
+            prefetch.join()  # no import of the same modules from two threads at once
+        return _finish(settings, run, trace_file, painter)
+
+
+def _finish(settings: TrackSettings, run: _Run, trace_file: Path, painter: Painter) -> TrackResult:
+    """The report and the saved model of an appraised record."""
+    out = Path(settings.out_dir)
     _check_long_enough(run, settings, trace_file)
     trace = run.kept.trace()
     whole = run.whole.trace()
@@ -433,6 +462,7 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         summary=summary,
         steady=(model, source),
         recent=run.whole.last,
+        painter=painter,
         **_report_data(run, trace),
     )
     files = [trace_file, *report]
