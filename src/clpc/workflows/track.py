@@ -302,21 +302,37 @@ def _appraise(
                 run = _Run(appraiser, kept, 0, _Tail(factor))
             run.n_raw += values.shape[0]
             run.tail.feed(values[:, : n_in + n_out])
-            part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
-            if len(part):
-                part = dataclasses.replace(
-                    part,
-                    input_names=tuple(names[:n_in]),
-                    output_names=tuple(names[n_in : n_in + n_out]),
-                )
-                writer.write(part)
-                run.kept.add(part)
-                run.whole.add(part)
-            if after_first is not None:
+            if after_first is not None:  # a few rows first: the kernels are loaded after them
+                _push(run, names, values[:_FIRST_ROWS], writer, n_in, n_out)
                 after_first()
                 after_first = None
+                values = values[_FIRST_ROWS:]
+            _push(run, names, values, writer, n_in, n_out)
     assert run is not None  # iter_table_chunks raises on a file without rows
     return run
+
+
+#: rows of the first chunk appraised before ``after_first`` (the same trace: ``push`` does
+#: not depend on how the record is cut)
+_FIRST_ROWS = 2000
+
+
+def _push(
+    run: _Run, names: Any, values: np.ndarray, writer: TraceWriter, n_in: int, n_out: int
+) -> None:
+    """Appraise ``values`` (inputs, outputs, then other columns); keep and write the updates."""
+    if not values.shape[0]:
+        return
+    part = run.appraiser.push(values[:, :n_in], values[:, n_in : n_in + n_out])
+    if len(part):
+        part = dataclasses.replace(
+            part,
+            input_names=tuple(names[:n_in]),
+            output_names=tuple(names[n_in : n_in + n_out]),
+        )
+        writer.write(part)
+        run.kept.add(part)
+        run.whole.add(part)
 
 
 def _chunks(record: RecordSpec, chunk_rows: int, progress: ChunkFilter | None) -> Iterator[Chunk]:
@@ -376,9 +392,29 @@ def _import_quietly(names: tuple[str, ...]) -> None:
             return
 
 
-def _prefetch(names: tuple[str, ...]) -> threading.Thread:
-    """Import ``names`` in a background thread (joined before they are used)."""
-    thread = threading.Thread(target=_import_quietly, args=(names,), name="clpc-prefetch")
+def _load_numba() -> None:
+    """Import numba and set up its compiler (0.3 s, once per process) on a small filter."""
+    try:
+        from clpc.core.filters import all_pole
+
+        all_pole(np.array([1.0, -0.5]), np.ones(4))
+    except Exception:  # the appraiser's own call says what is wrong
+        return
+
+
+def _prefetch(names: tuple[str, ...], numba: bool = False) -> threading.Thread:
+    """Import ``names`` (and load numba) in a background thread, joined before they are used.
+
+    The main thread meanwhile reads and appraises: pyarrow's reader, the trace writer and
+    the compiled kernel release the GIL.
+    """
+
+    def work() -> None:
+        if numba:
+            _load_numba()
+        _import_quietly(names)
+
+    thread = threading.Thread(target=work, name="clpc-prefetch")
     thread.daemon = True
     thread.start()
     return thread
@@ -428,11 +464,17 @@ def track_file(
     out = Path(settings.out_dir)
     trace_file = out / f"trace.{settings.fmt}"
     with Painter(enabled=None if fork_figures else False) as painter:
-        # forked after the first chunk, the painter imports matplotlib meanwhile; without it,
-        # a thread does (and both import numba while the first chunk is read)
-        prefetch = _prefetch(("numba",) if painter.enabled else ("numba", *_REPORT_MODULES))
+        # numba is loaded in a thread while the first chunk is read; the painter is forked
+        # after it (and after the first rows: the kernels are loaded) and imports matplotlib
+        # while the record is appraised. Without it, the thread imports matplotlib as well.
+        prefetch = _prefetch(() if painter.enabled else _REPORT_MODULES, numba=True)
+
+        def fork_painter() -> None:
+            prefetch.join()  # no fork while a thread is inside numba's compiler
+            painter.start()
+
         try:
-            run = _appraise(settings, trace_file, progress, painter.start)
+            run = _appraise(settings, trace_file, progress, fork_painter)
         finally:
             prefetch.join()  # no import of the same modules from two threads at once
         return _finish(settings, run, trace_file, painter)
