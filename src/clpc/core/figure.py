@@ -30,6 +30,7 @@ __all__ = [
     "draw_signal",
     "envelope",
     "new_figure",
+    "new_grid",
     "place_legend",
     "save_figure",
     "time_label",
@@ -76,18 +77,31 @@ def new_figure(
         Fixed margins and gaps; by default matplotlib's constrained layout places the axes
         (it measures every tick label, about a third of a figure's drawing time).
     """
+    fig = _figure((width, 0.7 + height * n_rows), constrained=margins is None)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    if margins is not None:
+        margins.apply(fig, n_rows, n_cols)
+    return fig, axes
+
+
+def new_grid(n_rows: int, n_cols: int, margins: Margins, *, height: float, width: float = 8.0):
+    """A new Agg-backed figure and an empty grid (``GridSpec``) placed by ``margins``.
+
+    For figures whose axes span cells (see :func:`new_figure` for the sizes).
+    """
+    fig = _figure((width, 0.7 + height * n_rows), constrained=False)
+    return fig, fig.add_gridspec(n_rows, n_cols, **margins.fractions(fig, n_rows, n_cols))
+
+
+def _figure(size: tuple[float, float], *, constrained: bool) -> Any:
     try:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
     except ImportError:  # pragma: no cover - depends on the environment
         raise ImportError(INSTALL_HINT) from None
-    size = (width, 0.7 + height * n_rows)
-    fig = Figure(figsize=size, layout="constrained" if margins is None else None)
+    fig = Figure(figsize=size, layout="constrained" if constrained else None)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
-    if margins is not None:
-        margins.apply(fig, n_rows, n_cols)
-    return fig, axes
+    return fig
 
 
 @dataclass(frozen=True)
@@ -106,19 +120,23 @@ class Margins:
     row_gap: float = 0.7
     col_gap: float = 0.95
 
-    def apply(self, fig: Any, n_rows: int, n_cols: int) -> None:
-        """Place ``fig``'s grid of ``n_rows`` x ``n_cols`` axes."""
+    def fractions(self, fig: Any, n_rows: int, n_cols: int) -> dict[str, float]:
+        """``left, right, top, bottom, hspace, wspace`` of a grid of axes in ``fig``."""
         w, h = fig.get_size_inches()
         axes_h = (h - self.top - self.bottom - (n_rows - 1) * self.row_gap) / n_rows
         axes_w = (w - self.left - self.right - (n_cols - 1) * self.col_gap) / n_cols
-        fig.subplots_adjust(
-            left=self.left / w,
-            right=1.0 - self.right / w,
-            top=1.0 - self.top / h,
-            bottom=self.bottom / h,
-            hspace=self.row_gap / max(axes_h, 1e-3),
-            wspace=self.col_gap / max(axes_w, 1e-3),
-        )
+        return {
+            "left": self.left / w,
+            "right": 1.0 - self.right / w,
+            "top": 1.0 - self.top / h,
+            "bottom": self.bottom / h,
+            "hspace": self.row_gap / max(axes_h, 1e-3),
+            "wspace": self.col_gap / max(axes_w, 1e-3),
+        }
+
+    def apply(self, fig: Any, n_rows: int, n_cols: int) -> None:
+        """Place ``fig``'s grid of ``n_rows`` x ``n_cols`` axes."""
+        fig.subplots_adjust(**self.fractions(fig, n_rows, n_cols))
 
 
 def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tuple[Any, list]:
@@ -159,7 +177,8 @@ def save_figure(fig: Any, path: str | PathLike[str] | None) -> None:
         return
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110, format="png")
+    # zlib level 1, not Pillow's 6: a long trace's figure encodes 0.07 s faster, 16 % larger
+    fig.savefig(out, dpi=110, format="png", pil_kwargs={"compress_level": 1})
 
 
 def envelope(

@@ -13,7 +13,7 @@ from clpc.core.figure import (
     Margins,
     axes_for,
     draw_signal,
-    new_figure,
+    new_grid,
     place_legend,
     save_figure,
     time_label,
@@ -98,18 +98,12 @@ def plot_trace(
     n_eq, p = trace.n_equations, len(labels)
     if ax is None:
         n_rows = -(-p // 2)
-        fig, grid = new_figure(n_eq * (1 + n_rows), 2, height=1.7, margins=_MARGINS)
+        fig, grid = new_grid(n_eq * (1 + n_rows), 2, _MARGINS, height=1.7)
         axes = []
         for e in range(n_eq):
             top = e * (1 + n_rows)
-            gs = grid[top, 0].get_gridspec()
-            for a in grid[top]:
-                a.remove()
-            axes.append(fig.add_subplot(gs[top, :]))
-            cells = [grid[top + 1 + k // 2, k % 2] for k in range(2 * n_rows)]
-            axes += cells[:p]
-            for extra in cells[p:]:
-                extra.set_visible(False)
+            axes.append(fig.add_subplot(grid[top, :]))
+            axes += [fig.add_subplot(grid[top + 1 + k // 2, k % 2]) for k in range(p)]
     else:
         fig, axes = axes_for(ax, trace_panels(trace))
     t = np.asarray(trace.time, dtype=float)
