@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import threading
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -161,6 +162,8 @@ class Painter:
         self._pid: int | None = None
         self._jobs: list[FigureJob] = []
         self._sent = False
+        self._sender: threading.Thread | None = None
+        self._send_error: Exception | None = None
 
     @property
     def forked(self) -> bool:
@@ -186,15 +189,23 @@ class Painter:
         self._conn, self._pid = mine, pid
 
     def submit(self, jobs: list[FigureJob]) -> None:
-        """Hand the figures over (drawn meanwhile when forked, else by :meth:`wait`)."""
+        """Hand the figures over (drawn meanwhile when forked, else by :meth:`wait`).
+
+        The jobs (a long trace is several MB) are sent by a thread: the caller goes on
+        while the forked process finishes its warm-up and reads them.
+        """
         self._jobs = list(jobs)
         self._sent = False
         if self._conn is not None and self._jobs:
-            try:
-                self._conn.send(self._jobs)
-                self._sent = True
-            except Exception:  # an unpicklable job, the process gone: draw here
-                self.close(kill=True)
+            self._sender = threading.Thread(target=self._send, name="clpc-painter-send")
+            self._sender.start()
+            self._sent = True
+
+    def _send(self) -> None:
+        try:
+            self._conn.send(self._jobs)
+        except Exception as exc:  # an unpicklable job, the process gone: drawn here
+            self._send_error = exc
 
     def wait(self) -> None:
         """Return when every submitted figure is written.
@@ -207,6 +218,12 @@ class Painter:
         """
         jobs, failed = self._jobs, list(range(len(self._jobs)))
         self._jobs = []
+        if self._sender is not None:
+            self._sender.join()
+            self._sender = None
+        if self._send_error is not None:
+            self._send_error = None
+            self.close(kill=True)
         if self._sent and self._conn is not None:
             self._sent = False
             try:
@@ -227,6 +244,8 @@ class Painter:
         """End the forked process (``kill``: at once, without waiting for its warm-up)."""
         if self._conn is None or self._pid is None:
             return
+        if self._sender is not None and not kill:
+            self._sender.join()
         conn, pid = self._conn, self._pid
         self._conn = self._pid = None
         try:
