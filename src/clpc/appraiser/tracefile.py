@@ -185,6 +185,11 @@ class TraceWriter:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="clpc-trace")
         self._pending = self._pool.submit(fn, *args)
 
+    def drain(self) -> None:
+        """Wait until every part handed over so far is written (its error is raised)."""
+        if self._pending is not None:
+            self._pending.result()
+
     def close(self) -> None:
         """Finish the writes, flush and close the file (an error of a write is raised)."""
         pending, self._pending = self._pending, None

@@ -33,7 +33,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import linalg
 
 from clpc.model.simulation import noise_models
 
@@ -287,6 +286,8 @@ def _quadratic(cov: np.ndarray, r: np.ndarray) -> float:
     A Cholesky factorisation; a ``P`` that is not positive definite even then (estimated
     correlations can make it so) has its eigenvalues clipped at ``eps`` instead.
     """
+    from scipy import linalg  # imported when used: every command imports this module
+
     eps = RIDGE * max(float(np.max(np.diag(cov))), np.finfo(float).tiny)
     reg = 0.5 * (cov + cov.T) + eps * np.eye(cov.shape[0])
     try:

@@ -197,13 +197,15 @@ class Painter:
         self._jobs = list(jobs)
         self._sent = False
         if self._conn is not None and self._jobs:
-            self._sender = threading.Thread(target=self._send, name="clpc-painter-send")
+            self._sender = threading.Thread(
+                target=self._send, args=(self._jobs,), name="clpc-painter-send"
+            )
             self._sender.start()
             self._sent = True
 
-    def _send(self) -> None:
+    def _send(self, jobs: list[FigureJob]) -> None:
         try:
-            self._conn.send(self._jobs)
+            self._conn.send(jobs)
         except Exception as exc:  # an unpicklable job, the process gone: drawn here
             self._send_error = exc
 

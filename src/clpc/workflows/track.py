@@ -304,6 +304,7 @@ def _appraise(
             run.tail.feed(values[:, : n_in + n_out])
             if after_first is not None:  # a few rows first: the kernels are loaded after them
                 _push(run, names, values[:_FIRST_ROWS], writer, n_in, n_out)
+                writer.drain()  # no thread inside pyarrow's writer when after_first forks
                 after_first()
                 after_first = None
                 values = values[_FIRST_ROWS:]
