@@ -41,3 +41,25 @@ def test_thinned_trace_is_bounded_and_evenly_strided():
     np.testing.assert_array_equal(thin.theta, whole.theta[:: kept.stride])
     with pytest.raises(ValueError, match="max_updates"):
         ThinnedTrace(0)
+
+
+def test_a_failed_background_write_is_raised_by_the_next_write_or_close(tmp_path, monkeypatch):
+    pa_csv = pytest.importorskip("pyarrow.csv")
+    parts, _ = parts_and_whole()
+    calls = []
+
+    def broken(table, sink, options):
+        calls.append(table.num_rows)
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pa_csv, "write_csv", broken)
+    w = TraceWriter(tmp_path / "trace.csv")
+    w.write(parts[0])  # handed to the writer's thread
+    with pytest.raises(OSError, match="disk full"):
+        w.write(parts[1])  # waits for the first: its error surfaces here, once
+    assert calls == [len(parts[0])]  # the second part was not handed over
+    w.write(parts[2])
+    with pytest.raises(OSError, match="disk full"):
+        w.close()  # the third failed as well: close says so
+    assert calls == [len(parts[0]), len(parts[2])]
+    w.close()  # closed: nothing more to raise

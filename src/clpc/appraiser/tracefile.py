@@ -177,18 +177,19 @@ class TraceWriter:
         """Run ``fn(*args)`` in a thread, after the writes before it.
 
         pyarrow's CSV writer releases the GIL: the rows are formatted while the appraiser
-        computes the next chunk. The error of an earlier write is raised here.
+        computes the next chunk. The error of an earlier write is raised here (once; that
+        part is not retried and this one is not written).
         """
-        if self._pending is not None:
-            self._pending.result()
+        self.drain()
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="clpc-trace")
         self._pending = self._pool.submit(fn, *args)
 
     def drain(self) -> None:
-        """Wait until every part handed over so far is written (its error is raised)."""
-        if self._pending is not None:
-            self._pending.result()
+        """Wait until every part handed over so far is written (its error is raised once)."""
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            pending.result()
 
     def close(self) -> None:
         """Finish the writes, flush and close the file (an error of a write is raised)."""
