@@ -1,4 +1,4 @@
-"""Candidates of :func:`clpc.identify` fitted and scored in two folds, and the choice among them.
+"""Candidates of :func:`clpc.identify` fitted and scored at rolling origins, and the choice.
 
 See :mod:`clpc.lpc.selection` for the rules; every threshold of them lives here.
 """
@@ -21,6 +21,7 @@ from clpc.model import LinearModel, ModelError
 __all__ = [
     "MAKERS",
     "PARSIMONY",
+    "WINDOWS",
     "best_row",
     "candidate",
     "choose",
@@ -28,11 +29,16 @@ __all__ = [
     "final_model",
     "fold_fits",
     "grid",
+    "ranked",
+    "rolling_origin",
+    "stable_refits",
     "tier",
 ]
 
 #: Points of free-run fit a lower order or a smaller delay may give away.
 PARSIMONY = 1.0
+#: Scored windows (rolling origins) at the end of the record.
+WINDOWS = 3
 MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
 _USABLE = ("stable", "integrating")
 
@@ -40,6 +46,21 @@ _USABLE = ("stable", "integrating")
 def _cheap(**kw: Any) -> dict[str, Any]:
     """Settings of a candidate fit: no covariance, no held-out assessment (scored here)."""
     return kw | {"uncertainty": False, "assess": False}
+
+
+def rolling_origin(data: IOData, fraction: float) -> list[tuple[IOData, IOData]]:
+    """The (fitted, scored) parts: :data:`WINDOWS` forward windows at the end of the record.
+
+    Each window holds ``round(fraction * n)`` samples (the last one the rest); the model
+    scored on a window is fitted on every sample before it, as the final model is fitted on
+    the record and used after it.
+    """
+    n = data.n_samples
+    w = round(fraction * n)
+    origins = [n - m * w for m in range(WINDOWS, 0, -1)]
+    return [
+        (data[:o], data[o : o + w] if m < WINDOWS - 1 else data[o:]) for m, o in enumerate(origins)
+    ]
 
 
 def fold_fits(model: LinearModel, seg: IOData, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -68,21 +89,27 @@ def candidate(
     folds, k = where
     n_out = folds[0][0].n_outputs
     base = {"estimator": name, "order": order, "nk": nk}
-    free, kst, note = np.zeros(n_out), np.zeros(n_out), ""
+    windows, kst, note = np.zeros((len(folds), n_out)), np.zeros(n_out), ""
     radius = np.zeros(n_out)
     try:
-        for est, val in folds:
+        for w, (est, val) in enumerate(folds):
             model = MAKERS[name](**_cheap(order=order, nk=nk, mimo=mimo)).fit(est)
             radius = np.maximum(radius, [np.max(np.abs(model.poles(j))) for j in range(n_out)])
-            f, p = fold_fits(model, val, k)
-            free, kst = free + f / len(folds), kst + p / len(folds)
+            windows[w], p = fold_fits(model, val, k)
+            kst = kst + p / len(folds)
     except (ModelError, DataError, np.linalg.LinAlgError) as exc:
-        free, kst, note = np.full(n_out, -math.inf), np.full(n_out, -math.inf), str(exc)
+        windows, kst, note = (
+            np.full((len(folds), n_out), -math.inf),
+            np.full(n_out, -math.inf),
+            str(exc),
+        )
         radius = np.full(n_out, math.nan)
+    free = windows.mean(axis=0)
     names = folds[0][0].output_names
     return [
         base
         | {"output": names[j], "free_run": float(free[j]), "kstep": float(kst[j])}
+        | {"windows": [float(v) for v in windows[:, j]]}
         | {"stability": _stability(float(radius[j])), "max_pole": float(radius[j])}
         | {"chosen": False, "note": note}
         for j in range(n_out)
@@ -110,12 +137,53 @@ def tier(row: dict[str, Any]) -> int:
     return 1 if row["stability"] in _USABLE else 2
 
 
+def ranked(rows: list[dict[str, Any]], idx: list[int]) -> list[int]:
+    """``idx`` best first: by :func:`tier`, then by free-run fit (the first of equals first)."""
+    return sorted(idx, key=lambda i: (tier(rows[i]), -rows[i]["free_run"]))
+
+
 def best_row(rows: list[dict[str, Any]], idx: list[int]) -> tuple[int, bool]:
     """The chosen row among ``idx`` (see the module) and whether it is strictly stable."""
-    level = min(tier(rows[i]) for i in idx)
-    pool = [i for i in idx if tier(rows[i]) == level]
-    top = max(pool, key=lambda i: rows[i]["free_run"])  # the first of equals
-    return top, level == 0
+    top = ranked(rows, idx)[0]
+    return top, tier(rows[top]) == 0
+
+
+def stable_refits(
+    data: IOData, rows: list[dict[str, Any]], picks: list[int], mimo: str | None
+) -> list[int]:
+    """Per output, the first ranked candidate whose refit on the whole record is strictly stable.
+
+    A candidate stable in every window may still be unstable when refitted on the whole
+    record; then the next one of the same order (:func:`ranked`) is taken and the row's
+    ``note`` says why. OE is stable by construction and is not refitted here. When no
+    refit is strictly stable the pick is kept.
+    """
+    radius: dict[str, np.ndarray] = {}
+    out = []
+    for j, i in enumerate(picks):
+        same = [x for x, r in enumerate(rows) if r["order"] == rows[i]["order"]]
+        pool = ranked(rows, [x for x in same if rows[x]["output"] == rows[i]["output"]])
+        pool = pool[pool.index(i) :]
+        for x in pool:
+            name = rows[x]["estimator"]
+            if name != "oe" and name not in radius:
+                settings = _cheap(order=rows[x]["order"], nk=rows[x]["nk"], mimo=mimo)
+                try:
+                    m = MAKERS[name](**settings).fit(data)
+                    radius[name] = np.array(
+                        [np.max(np.abs(m.poles(o))) for o in range(m.n_outputs)]
+                    )
+                except (ModelError, DataError, np.linalg.LinAlgError):
+                    radius[name] = np.full(data.n_outputs, math.inf)
+            if name == "oe" or radius[name][j] < 1.0:
+                out.append(x)
+                break
+            rows[x]["note"] = (
+                f"refitted on the whole record: unstable (largest pole {radius[name][j]:.4g})"
+            )
+        else:
+            out.append(i)
+    return out
 
 
 def choose(

@@ -1,20 +1,24 @@
 """``identify``: the best of LPC, least squares and output error for a record, and why.
 
-Every candidate (estimator x order) is scored on data it was not fitted to, in two folds:
-fitted on the first ``1 - f`` of the record and scored on the last ``f``, then fitted on the
-last ``1 - f`` and scored on the first ``f`` (``f = validation_fraction``). Each fold gives,
+Every candidate (estimator x order) is scored on data it was not fitted to, forward in time
+at rolling origins: the last ``3 f`` of the record are cut into three windows of ``f`` each
+(``f = validation_fraction``, default 0.2); the candidate scored on a window is fitted on
+every sample before it (the first ``1 - 3 f``, then ``1 - 2 f``, then ``1 - f`` of the
+record), as the final model is fitted on the record and used after it. Each window gives,
 per output, the **free-run** fit % (the simulation from the input alone, started from the
 measured samples before the scored ones) and the **k-step** prediction fit % (``k``: one
-dominant time constant of the least-squares model of the first fold,
-:func:`clpc.lpc.heldout.horizon`); the table holds their means over the two folds (two, so
-that no single stretch of the record decides alone).
+dominant time constant of the least-squares model fitted before the first window,
+:func:`clpc.lpc.heldout.horizon`); the table holds their means over the three windows
+(``windows``: the free runs one by one).
 
-* **Choice**, per output: the highest free-run fit among the candidates whose poles are all
-  strictly inside the unit circle in both folds (if there are none: among those within
+* **Choice**, per output: the highest mean free-run fit among the candidates whose poles are
+  all strictly inside the unit circle in every window (if there are none: among those within
   :data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL` of it, then among the rest). The model is meant
   to simulate the process, and the free run is the stricter test (a prediction re-reads the
   measured output every ``k`` samples). So an unstable model is never chosen while a stable
   candidate exists; OE is stable by construction, so one always does when OE can be fitted.
+  A choice whose refit on the whole record is unstable gives way to the next candidate
+  (:func:`clpc.lpc.comparison.stable_refits`).
   Outputs are separate equations, so a multi-output model may take each output from
   another estimator (``info["estimators"]``).
 * **Order** (``order="auto"``): the lowest order whose mean over the outputs of the chosen
@@ -27,6 +31,11 @@ that no single stretch of the record decides alone).
   structure.
 
 The chosen estimators are then refitted on the whole record.
+
+Why forward windows: ``benchmarks/selection_rules.py`` measured the rules on the real
+records split three ways and on simulated ones; scoring forward at rolling origins was
+better than the earlier two folds (one fitted on the last two thirds and scored on the
+first) on every split, and folds scored backward in time were the worst (``docs/method.md``).
 """
 
 from __future__ import annotations
@@ -42,10 +51,13 @@ from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
 from clpc.lpc.arx import ARX
 from clpc.lpc.comparison import (
+    WINDOWS,
     choose,
     choose_delay,
     final_model,
     grid,
+    rolling_origin,
+    stable_refits,
     tier,
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
@@ -68,9 +80,10 @@ class Identification:
         The chosen model, refitted on the whole record.
     table : list of dict
         One row per candidate and output: ``estimator``, ``order``, ``nk``, ``output``,
-        ``free_run``, ``kstep`` (fit %, mean of the two folds, ``-inf`` when one diverges),
-        ``stability`` (the worse of the two folds' models), ``chosen`` and ``note`` (why a
-        fit failed). ``pandas.DataFrame(table)`` makes it a frame.
+        ``free_run``, ``kstep`` (fit %, mean of the three windows, ``-inf`` when one
+        diverges), ``windows`` (the free-run fit % of each window), ``stability`` (the worst
+        of the windows' models), ``chosen`` and ``note`` (why a fit failed or a choice gave
+        way). ``pandas.DataFrame(table)`` makes it a frame.
     reason : str
         Why this model, in words (with the delay and the errors-in-variables check).
     estimators : tuple of str
@@ -119,7 +132,7 @@ def identify(
     max_delay: int = 4,
     mimo: str | None = None,
     k: int | None = None,
-    validation_fraction: float = 1.0 / 3.0,
+    validation_fraction: float = 0.2,
 ) -> Identification:
     """Fit LPC, least squares (ARX) and output error (OE); return the best with the evidence.
 
@@ -141,7 +154,7 @@ def identify(
     k : int, optional
         Prediction horizon [samples]; default from the data.
     validation_fraction : float
-        Share of the record scored in each fold (0 < f <= 0.5).
+        Share of the record in each of the three scored windows (0 < f <= 0.25).
 
     Returns
     -------
@@ -158,22 +171,25 @@ def identify(
     check_choice(estimator, "estimator", ESTIMATORS)
     orders = _range(order, "order", 1, max_order)
     delays = _range(nk, "nk", 0, max_delay)
-    if not 0.0 < validation_fraction <= 0.5:
-        raise ValueError(f"validation_fraction must be in (0, 0.5]; got {validation_fraction!r}.")
-    data = as_iodata(u, y, dt)
-    n_val = round(data.n_samples * validation_fraction)
-    need = 4 * (max(orders) + max(delays) + 2) * (data.n_inputs + 1)
-    if n_val < need:
-        raise DataError(
-            f"identify needs at least {need} samples in each held-out part (order "
-            f"{max(orders)}, delay {max(delays)}, {data.n_inputs} input(s)); got {n_val} of "
-            f"{data.n_samples}. Use a longer record, a lower max order or max delay, or a "
-            "larger validation_fraction."
+    if not 0.0 < validation_fraction <= 0.25:
+        raise ValueError(
+            f"validation_fraction must be in (0, 0.25] (three windows of it end the record); "
+            f"got {validation_fraction!r}."
         )
-    folds = [(data[: data.n_samples - n_val], data[data.n_samples - n_val :])]
-    folds.append((data[n_val:], data[:n_val]))
+    data = as_iodata(u, y, dt)
+    folds = rolling_origin(data, validation_fraction)
+    n_fit, n_val = folds[0][0].n_samples, sum(val.n_samples for _, val in folds)
+    need = 4 * (max(orders) + max(delays) + 2) * (data.n_inputs + 1)
+    if min(n_fit, n_val) < need:
+        raise DataError(
+            f"identify needs at least {need} samples before the first scored window and in "
+            f"the {WINDOWS} windows together (order {max(orders)}, delay {max(delays)}, "
+            f"{data.n_inputs} input(s)); got {n_fit} and {n_val} of {data.n_samples}. Use a "
+            "longer record, a lower max order or max delay, or another validation_fraction."
+        )
     if k is None:
-        k = heldout.horizon(ARX(order=orders[0], mimo=mimo, assess=False).fit(folds[0][0]), n_val)  # type: ignore[arg-type]
+        lowest = ARX(order=orders[0], mimo=mimo, assess=False).fit(folds[0][0])  # type: ignore[arg-type]
+        k = heldout.horizon(lowest, folds[0][1].n_samples)
     k = check_int(k, "k", 1)
     delay_rows: list[dict[str, Any]] = []
     if len(delays) > 1:
@@ -182,7 +198,8 @@ def identify(
         chosen_nk = delays[0]
         rows = grid(folds, orders, chosen_nk, (mimo, k))
     names = data.output_names
-    pick_order, picks = choose(rows, estimator, names)
+    pick_order, first = choose(rows, estimator, names)
+    picks = stable_refits(data, rows, first, mimo) if estimator == "auto" else first
     for i in picks:
         rows[i]["chosen"] = True
     chosen = tuple(rows[i]["estimator"] for i in picks)
@@ -194,7 +211,7 @@ def identify(
         eiv: EivCheck | None = check_eiv(data, oe_model)
     except (ModelError, DataError, np.linalg.LinAlgError):
         eiv = None
-    parts = [_why(rows, picks, estimator, k, names)]
+    parts = [_why(rows, (first, picks), estimator, k, names)]
     if delay_rows:
         scan = ", ".join(f"nk={r['nk']}: {r['free_run']:.1f}" for r in delay_rows)
         parts.append(f"delay nk={chosen_nk}: the best stable held-out free run, per delay: {scan}")
@@ -216,15 +233,23 @@ def _range(value: Any, name: str, low: int, high: int) -> list[int]:
 
 
 def _why(
-    rows: list[dict[str, Any]], picks: list[int], estimator: str, k: int, names: tuple[str, ...]
+    rows: list[dict[str, Any]],
+    choice: tuple[list[int], list[int]],
+    estimator: str,
+    k: int,
+    names: tuple[str, ...],
 ) -> str:
-    """The choice in words."""
+    """The choice in words (``choice``: the first picks and those kept after the refits)."""
     parts = []
-    for j, i in enumerate(picks):
+    for j, (i0, i) in enumerate(zip(*choice, strict=True)):
         r = rows[i]
         what = f"{r['estimator'].upper()} (order {r['order']}, nk {r['nk']})"
         out = f"output {names[j]}: " if len(names) > 1 else ""
-        fits = f"held-out free run {pct(r['free_run'])}, {k}-step {pct(r['kstep'])}"
+        each = ", ".join(pct(v) for v in r["windows"])
+        fits = (
+            f"held-out free run {pct(r['free_run'])} (mean of the {WINDOWS} forward windows: "
+            f"{each}), {k}-step {pct(r['kstep'])}"
+        )
         others = [
             f"{x['estimator'].upper()} {_fmt(x)}"
             for x in rows
@@ -233,6 +258,11 @@ def _why(
         level = tier(r)
         if estimator != "auto":
             how = "as asked"
+        elif i != i0:
+            how = (
+                f"{rows[i0]['estimator'].upper()} did better held out but its refit on the "
+                "whole record is unstable; the next best"
+            )
         elif level == 0:
             how = "the best held-out free run among the stable candidates"
         elif level == 1:
