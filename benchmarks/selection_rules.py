@@ -21,7 +21,7 @@ Splits of each real record (estimation mean removed from both parts):
 * ``reversed``: last 60 % estimation, first 40 % validation (cascaded_tanks: its records
   swapped);
 * ``sim``: simulated records (two systems; white output noise, errors in variables, equation
-  error; 3 seeds each; orders: true and true + 1), first 60 % / last 40 %.
+  error; 6 seeds each; orders: true and true + 1), first 60 % / last 40 %.
 
 Fold parts (fractions of the estimation part, ``fit -> scored``): ``A`` 0-2/3 -> 2/3-1,
 ``B`` 1/3-1 -> 0-1/3 (the two folds of ``identify`` today), ``C`` 0-1/2 -> 1/2-1,
@@ -88,18 +88,19 @@ def real(split: str) -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
         if isinstance(d, tuple):
             parts = {"bench": d, "reversed": d[::-1]}.get(split)
             if parts is None:
-                half = d[0].n_samples // 2
-                parts = (d[0][:half], d[0][half:])
+                cut = d[0].n_samples // 2 if split == "half" else round(0.7 * d[0].n_samples)
+                parts = (d[0][:cut], d[0][cut:])
         else:
             n = d.n_samples
-            cut = {"bench": round(0.6 * n), "half": n // 2, "reversed": round(0.4 * n)}[split]
+            cuts = {"bench": 0.6, "half": 0.5, "reversed": 0.4, "seventy": 0.7}
+            cut = round(cuts[split] * n)
             parts = (d[:cut], d[cut:]) if split != "reversed" else (d[cut:], d[:cut])
         out.append((name, *centred(*parts), list(ORDERS)))
     return out
 
 
-def simulated() -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
-    """Two systems x three noise kinds x three seeds, 1000 samples, 60/40."""
+def simulated(seeds: range) -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
+    """Two systems x three noise kinds x ``seeds``, 1000 samples, 60/40."""
     systems = {
         "s2": (np.poly([0.9 * np.exp(0.3j), 0.9 * np.exp(-0.3j)]).real, [0.0, 0.5, 0.3]),
         "s3": (np.poly([0.95 * np.exp(0.2j), 0.95 * np.exp(-0.2j), 0.7]).real, [0, 0.2, 0.1, 0.05]),
@@ -108,7 +109,7 @@ def simulated() -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
     for sname, (a, b) in systems.items():
         n_true = len(a) - 1
         for kind in ("output", "eiv", "equation"):
-            for seed in range(3):
+            for seed in seeds:
                 rng = np.random.default_rng(1000 * seed + 7)
                 u0 = signal.lfilter([1.0], [1.0, -0.7], rng.standard_normal(1000))
                 y0 = signal.lfilter(b, a, u0)
@@ -125,6 +126,14 @@ def simulated() -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
                 est, val = centred(d[:600], d[600:])
                 out.append((f"{sname}/{kind}/{seed}", est, val, [n_true, n_true + 1]))
     return out
+
+
+def records(split: str) -> list[tuple[str, clpc.IOData, clpc.IOData, list[int]]]:
+    if split == "sim":
+        return simulated(range(6))
+    if split == "sim2":
+        return simulated(range(6, 12))
+    return real(split)
 
 
 # ====================================================================== fits
@@ -325,7 +334,7 @@ def main(argv: list[str] | None = None) -> int:
             data[split] = pickle.loads(path.read_bytes())
             continue
         t0 = time.perf_counter()
-        recs = simulated() if split == "sim" else real(split)
+        recs = records(split)
         data[split] = measure(recs)
         path.write_bytes(pickle.dumps(data[split]))
         print(f"({split}: {time.perf_counter() - t0:.0f} s)", file=sys.stderr)
@@ -340,7 +349,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.identify:
         cells = []
         for split, rows in data.items():
-            recs = simulated() if split == "sim" else real(split)
+            recs = records(split)
             chosen = iter(identify_rows(recs))
             hits, bad, misses = evaluate(rows, lambda r, c=chosen: fixed(next(c))(r), False)
             cells.append(f"{hits}" + (f" ({bad} unstable)" if bad else ""))

@@ -72,9 +72,9 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     assert found is not None
     many = len({r["output"] for r in found.table}) > 1
     lines = [
-        "estimator comparison (fitted on two thirds of the record, scored on the other third, "
-        f"both ways round; free run and {found.horizon}-step prediction fit %, higher is "
-        "better):"
+        "estimator comparison (scored on three windows of 20 % at the end of the record, each "
+        f"fitted on all before it; mean free run and {found.horizon}-step prediction fit %, "
+        "higher is better):"
     ]
     for r in found.table:
         out = f" {r['output']}" if many else ""

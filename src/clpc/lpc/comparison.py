@@ -1,6 +1,6 @@
-"""Candidates of :func:`clpc.identify` fitted and scored at rolling origins, and the choice.
+"""Candidates of :func:`clpc.identify` fitted and scored at rolling origins; the delay scan.
 
-See :mod:`clpc.lpc.selection` for the rules; every threshold of them lives here.
+See :mod:`clpc.lpc.selection` for the rules and :mod:`clpc.lpc.choice` for the choice.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import numpy as np
 from clpc.data import DataError, IOData
 from clpc.lpc import assessment, heldout
 from clpc.lpc.arx import ARX
+from clpc.lpc.choice import best_row, ranked
 from clpc.lpc.estimator import LPC
 from clpc.lpc.oe import OE
 from clpc.lpc.uncertainty import with_covariance, without_covariance
@@ -20,27 +21,19 @@ from clpc.model import LinearModel, ModelError
 
 __all__ = [
     "MAKERS",
-    "PARSIMONY",
-    "WINDOWS",
-    "best_row",
+    "ORIGINS",
     "candidate",
-    "choose",
     "choose_delay",
     "final_model",
     "fold_fits",
     "grid",
-    "ranked",
     "rolling_origin",
     "stable_refits",
-    "tier",
 ]
 
-#: Points of free-run fit a lower order or a smaller delay may give away.
-PARSIMONY = 1.0
-#: Scored windows (rolling origins) at the end of the record.
-WINDOWS = 3
+#: The first two rolling origins, as shares of the record (the last: ``1 - f``).
+ORIGINS = (1.0 / 2.0, 2.0 / 3.0)
 MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
-_USABLE = ("stable", "integrating")
 
 
 def _cheap(**kw: Any) -> dict[str, Any]:
@@ -49,18 +42,14 @@ def _cheap(**kw: Any) -> dict[str, Any]:
 
 
 def rolling_origin(data: IOData, fraction: float) -> list[tuple[IOData, IOData]]:
-    """The (fitted, scored) parts: :data:`WINDOWS` forward windows at the end of the record.
+    """The (fitted, scored) parts at the rolling origins ``1/2, 2/3, 1 - fraction``.
 
-    Each window holds ``round(fraction * n)`` samples (the last one the rest); the model
-    scored on a window is fitted on every sample before it, as the final model is fitted on
-    the record and used after it.
+    At each origin the model is fitted on every sample before it and scored on every sample
+    after it, as the final model is fitted on the record and used after it.
     """
     n = data.n_samples
-    w = round(fraction * n)
-    origins = [n - m * w for m in range(WINDOWS, 0, -1)]
-    return [
-        (data[:o], data[o : o + w] if m < WINDOWS - 1 else data[o:]) for m, o in enumerate(origins)
-    ]
+    cuts = [round(share * n) for share in ORIGINS] + [n - round(fraction * n)]
+    return [(data[:o], data[o:]) for o in cuts]
 
 
 def fold_fits(model: LinearModel, seg: IOData, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -125,29 +114,6 @@ def _stability(radius: float) -> str:
     return "integrating" if radius >= 1.0 - heldout.UNIT_CIRCLE_TOL else "stable"
 
 
-def tier(row: dict[str, Any]) -> int:
-    """0: every pole strictly inside the unit circle (both folds); 1: on it; 2: unstable.
-
-    3: no finite free-run fit.
-    """
-    if not math.isfinite(row["free_run"]):
-        return 3
-    if row["max_pole"] < 1.0:
-        return 0
-    return 1 if row["stability"] in _USABLE else 2
-
-
-def ranked(rows: list[dict[str, Any]], idx: list[int]) -> list[int]:
-    """``idx`` best first: by :func:`tier`, then by free-run fit (the first of equals first)."""
-    return sorted(idx, key=lambda i: (tier(rows[i]), -rows[i]["free_run"]))
-
-
-def best_row(rows: list[dict[str, Any]], idx: list[int]) -> tuple[int, bool]:
-    """The chosen row among ``idx`` (see the module) and whether it is strictly stable."""
-    top = ranked(rows, idx)[0]
-    return top, tier(rows[top]) == 0
-
-
 def stable_refits(
     data: IOData, rows: list[dict[str, Any]], picks: list[int], mimo: str | None
 ) -> list[int]:
@@ -184,31 +150,6 @@ def stable_refits(
         else:
             out.append(i)
     return out
-
-
-def choose(
-    rows: list[dict[str, Any]], estimator: str, names: tuple[str, ...]
-) -> tuple[int, list[int]]:
-    """The chosen order and, per output, the index of the chosen row."""
-    orders = sorted({r["order"] for r in rows})
-    picks: dict[int, list[int]] = {}
-    mean: dict[int, float] = {}
-    for n in orders:
-        picks[n] = []
-        for out in names:
-            idx = [
-                i
-                for i, r in enumerate(rows)
-                if r["order"] == n and r["output"] == out and estimator in ("auto", r["estimator"])
-            ]
-            picks[n].append(best_row(rows, idx)[0])
-        mean[n] = float(np.mean([rows[i]["free_run"] for i in picks[n]]))
-    finite = [n for n in orders if math.isfinite(mean[n])] or orders
-    top = max(mean[n] for n in finite)
-    best = (
-        min(n for n in finite if not mean[n] < top - PARSIMONY) if math.isfinite(top) else orders[0]
-    )
-    return best, picks[best]
 
 
 def grid(
