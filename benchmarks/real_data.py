@@ -18,8 +18,8 @@ Methods:
   these five are fitted with ``uncertainty=False, assess=False``: the table needs the fits,
   not the parameter covariance or the verdict's held-out evidence (the model is the same);
 * ``auto``: ``clpc.identify(u, y, order=N, nk=0).model``, the best of LPC new, ARX and OE
-  scored forward in time on three windows of 20 % at the end of the estimation part, each
-  fitted on all of it before the window (it never sees the validation part);
+  fitted on the estimation part before each of three origins (1/2, 2/3, 0.8 of it) and
+  scored on the rest of it (it never sees the validation part);
 * ``LPC before``: ``clpc.LPC(order=N)`` of the package before the change (commit 7df4cf5,
   checked out at ``--baseline``), fitted in a subprocess that returns the parameters as
   JSON; the model is rebuilt and scored by the same code as the others.

@@ -20,8 +20,15 @@ Splits of each real record (estimation mean removed from both parts):
 * ``half``: first 50 % / last 50 % (cascaded_tanks: its estimation record halved);
 * ``reversed``: last 60 % estimation, first 40 % validation (cascaded_tanks: its records
   swapped);
+* ``seventy``: first 70 % / last 30 % (cascaded_tanks: its estimation record split so);
 * ``sim``: simulated records (two systems; white output noise, errors in variables, equation
-  error; 6 seeds each; orders: true and true + 1), first 60 % / last 40 %.
+  error; seeds 0-5; orders: true and true + 1), first 60 % / last 40 %; ``sim2``: seeds 6-11.
+
+``--identify`` adds a row for ``clpc.identify`` of the checkout imported (per output, the
+estimator it chose, scored by that estimator's final fit; a rule's row without it). The
+rows ``today`` and the variants are the rules as this script states them, with the fallback
+of ``identify`` (a choice whose final fit is unstable gives way to the next; ``--no-guard``
+drops it).
 
 Fold parts (fractions of the estimation part, ``fit -> scored``): ``A`` 0-2/3 -> 2/3-1,
 ``B`` 1/3-1 -> 0-1/3 (the two folds of ``identify`` today), ``C`` 0-1/2 -> 1/2-1,
@@ -30,7 +37,8 @@ Fold parts (fractions of the estimation part, ``fit -> scored``): ``A`` 0-2/3 ->
 
 Usage::
 
-    python benchmarks/selection_rules.py [--splits bench,half,reversed,sim] [--cache DIR]
+    python benchmarks/selection_rules.py [--splits bench,half,reversed,sim,seventy,sim2]
+        [--cache DIR] [--identify] [--detail RULE]
 
 Fits are cached in ``--cache`` (default ``/tmp/clpc-selection-rules``) per split; delete it
 after changing an estimator.
@@ -318,7 +326,7 @@ def identify_rows(recs: list) -> list[list[str]]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--splits", default="bench,half,reversed,sim")
+    ap.add_argument("--splits", default="bench,half,reversed,sim,seventy,sim2")
     ap.add_argument("--cache", type=Path, default=Path("/tmp/clpc-selection-rules"))
     ap.add_argument("--no-guard", action="store_true", help="no fallback from an unstable refit")
     ap.add_argument("--detail", action="append", default=[], help="print a rule's misses")

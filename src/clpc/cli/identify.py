@@ -72,8 +72,8 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     assert found is not None
     many = len({r["output"] for r in found.table}) > 1
     lines = [
-        "estimator comparison (scored on three windows of 20 % at the end of the record, each "
-        f"fitted on all before it; mean free run and {found.horizon}-step prediction fit %, "
+        "estimator comparison (fitted on the record before each origin at 1/2, 2/3 and 0.8 of "
+        f"it, scored on all after it; mean free run and {found.horizon}-step prediction fit %, "
         "higher is better):"
     ]
     for r in found.table:
