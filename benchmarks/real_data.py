@@ -17,8 +17,9 @@ Methods:
 * ``OE``: ``clpc.OE(order=N)``, output error (simulation-error least squares, stable);
   these five are fitted with ``uncertainty=False, assess=False``: the table needs the fits,
   not the parameter covariance or the verdict's held-out evidence (the model is the same);
-* ``auto``: ``clpc.identify(u, y, order=N, nk=0).model``, the best of LPC new, ARX and OE on
-  the last third of the estimation part (it never sees the validation part);
+* ``auto``: ``clpc.identify(u, y, order=N, nk=0).model``, the best of LPC new, ARX and OE
+  fitted on the estimation part before each of three origins (1/2, 2/3, 0.8 of it) and
+  scored on the rest of it (it never sees the validation part);
 * ``LPC before``: ``clpc.LPC(order=N)`` of the package before the change (commit 7df4cf5,
   checked out at ``--baseline``), fitted in a subprocess that returns the parameters as
   JSON; the model is rebuilt and scored by the same code as the others.

@@ -72,9 +72,9 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     assert found is not None
     many = len({r["output"] for r in found.table}) > 1
     lines = [
-        "estimator comparison (fitted on two thirds of the record, scored on the other third, "
-        f"both ways round; free run and {found.horizon}-step prediction fit %, higher is "
-        "better):"
+        "estimator comparison (fitted on the record before each origin at 1/2, 2/3 and 0.8 of "
+        f"it, scored on all after it; mean free run and {found.horizon}-step prediction fit %, "
+        "higher is better):"
     ]
     for r in found.table:
         out = f" {r['output']}" if many else ""

@@ -1,6 +1,6 @@
-"""Candidates of :func:`clpc.identify` fitted and scored in two folds, and the choice among them.
+"""Candidates of :func:`clpc.identify` fitted and scored at rolling origins; the delay scan.
 
-See :mod:`clpc.lpc.selection` for the rules; every threshold of them lives here.
+See :mod:`clpc.lpc.selection` for the rules and :mod:`clpc.lpc.choice` for the choice.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import numpy as np
 from clpc.data import DataError, IOData
 from clpc.lpc import assessment, heldout
 from clpc.lpc.arx import ARX
+from clpc.lpc.choice import best_row, ranked
 from clpc.lpc.estimator import LPC
 from clpc.lpc.oe import OE
 from clpc.lpc.uncertainty import with_covariance, without_covariance
@@ -20,26 +21,35 @@ from clpc.model import LinearModel, ModelError
 
 __all__ = [
     "MAKERS",
-    "PARSIMONY",
-    "best_row",
+    "ORIGINS",
     "candidate",
-    "choose",
     "choose_delay",
     "final_model",
     "fold_fits",
     "grid",
-    "tier",
+    "rolling_origin",
+    "stable_refits",
 ]
 
-#: Points of free-run fit a lower order or a smaller delay may give away.
-PARSIMONY = 1.0
+#: The first two rolling origins, as shares of the record (the last: ``1 - f``).
+ORIGINS = (1.0 / 2.0, 2.0 / 3.0)
 MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
-_USABLE = ("stable", "integrating")
 
 
 def _cheap(**kw: Any) -> dict[str, Any]:
     """Settings of a candidate fit: no covariance, no held-out assessment (scored here)."""
     return kw | {"uncertainty": False, "assess": False}
+
+
+def rolling_origin(data: IOData, fraction: float) -> list[tuple[IOData, IOData]]:
+    """The (fitted, scored) parts at the rolling origins ``1/2, 2/3, 1 - fraction``.
+
+    At each origin the model is fitted on every sample before it and scored on every sample
+    after it, as the final model is fitted on the record and used after it.
+    """
+    n = data.n_samples
+    cuts = [round(share * n) for share in ORIGINS] + [n - round(fraction * n)]
+    return [(data[:o], data[o:]) for o in cuts]
 
 
 def fold_fits(model: LinearModel, seg: IOData, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -68,21 +78,27 @@ def candidate(
     folds, k = where
     n_out = folds[0][0].n_outputs
     base = {"estimator": name, "order": order, "nk": nk}
-    free, kst, note = np.zeros(n_out), np.zeros(n_out), ""
+    windows, kst, note = np.zeros((len(folds), n_out)), np.zeros(n_out), ""
     radius = np.zeros(n_out)
     try:
-        for est, val in folds:
+        for w, (est, val) in enumerate(folds):
             model = MAKERS[name](**_cheap(order=order, nk=nk, mimo=mimo)).fit(est)
             radius = np.maximum(radius, [np.max(np.abs(model.poles(j))) for j in range(n_out)])
-            f, p = fold_fits(model, val, k)
-            free, kst = free + f / len(folds), kst + p / len(folds)
+            windows[w], p = fold_fits(model, val, k)
+            kst = kst + p / len(folds)
     except (ModelError, DataError, np.linalg.LinAlgError) as exc:
-        free, kst, note = np.full(n_out, -math.inf), np.full(n_out, -math.inf), str(exc)
+        windows, kst, note = (
+            np.full((len(folds), n_out), -math.inf),
+            np.full(n_out, -math.inf),
+            str(exc),
+        )
         radius = np.full(n_out, math.nan)
+    free = windows.mean(axis=0)
     names = folds[0][0].output_names
     return [
         base
         | {"output": names[j], "free_run": float(free[j]), "kstep": float(kst[j])}
+        | {"windows": [float(v) for v in windows[:, j]]}
         | {"stability": _stability(float(radius[j])), "max_pole": float(radius[j])}
         | {"chosen": False, "note": note}
         for j in range(n_out)
@@ -98,49 +114,42 @@ def _stability(radius: float) -> str:
     return "integrating" if radius >= 1.0 - heldout.UNIT_CIRCLE_TOL else "stable"
 
 
-def tier(row: dict[str, Any]) -> int:
-    """0: every pole strictly inside the unit circle (both folds); 1: on it; 2: unstable.
+def stable_refits(
+    data: IOData, rows: list[dict[str, Any]], picks: list[int], mimo: str | None
+) -> list[int]:
+    """Per output, the first ranked candidate whose refit on the whole record is strictly stable.
 
-    3: no finite free-run fit.
+    A candidate stable in every window may still be unstable when refitted on the whole
+    record; then the next one of the same order (:func:`ranked`) is taken and the row's
+    ``note`` says why. OE is stable by construction and is not refitted here. When no
+    refit is strictly stable the pick is kept.
     """
-    if not math.isfinite(row["free_run"]):
-        return 3
-    if row["max_pole"] < 1.0:
-        return 0
-    return 1 if row["stability"] in _USABLE else 2
-
-
-def best_row(rows: list[dict[str, Any]], idx: list[int]) -> tuple[int, bool]:
-    """The chosen row among ``idx`` (see the module) and whether it is strictly stable."""
-    level = min(tier(rows[i]) for i in idx)
-    pool = [i for i in idx if tier(rows[i]) == level]
-    top = max(pool, key=lambda i: rows[i]["free_run"])  # the first of equals
-    return top, level == 0
-
-
-def choose(
-    rows: list[dict[str, Any]], estimator: str, names: tuple[str, ...]
-) -> tuple[int, list[int]]:
-    """The chosen order and, per output, the index of the chosen row."""
-    orders = sorted({r["order"] for r in rows})
-    picks: dict[int, list[int]] = {}
-    mean: dict[int, float] = {}
-    for n in orders:
-        picks[n] = []
-        for out in names:
-            idx = [
-                i
-                for i, r in enumerate(rows)
-                if r["order"] == n and r["output"] == out and estimator in ("auto", r["estimator"])
-            ]
-            picks[n].append(best_row(rows, idx)[0])
-        mean[n] = float(np.mean([rows[i]["free_run"] for i in picks[n]]))
-    finite = [n for n in orders if math.isfinite(mean[n])] or orders
-    top = max(mean[n] for n in finite)
-    best = (
-        min(n for n in finite if not mean[n] < top - PARSIMONY) if math.isfinite(top) else orders[0]
-    )
-    return best, picks[best]
+    radius: dict[str, np.ndarray] = {}
+    out = []
+    for j, i in enumerate(picks):
+        same = [x for x, r in enumerate(rows) if r["order"] == rows[i]["order"]]
+        pool = ranked(rows, [x for x in same if rows[x]["output"] == rows[i]["output"]])
+        pool = pool[pool.index(i) :]
+        for x in pool:
+            name = rows[x]["estimator"]
+            if name != "oe" and name not in radius:
+                settings = _cheap(order=rows[x]["order"], nk=rows[x]["nk"], mimo=mimo)
+                try:
+                    m = MAKERS[name](**settings).fit(data)
+                    radius[name] = np.array(
+                        [np.max(np.abs(m.poles(o))) for o in range(m.n_outputs)]
+                    )
+                except (ModelError, DataError, np.linalg.LinAlgError):
+                    radius[name] = np.full(data.n_outputs, math.inf)
+            if name == "oe" or radius[name][j] < 1.0:
+                out.append(x)
+                break
+            rows[x]["note"] = (
+                f"refitted on the whole record: unstable (largest pole {radius[name][j]:.4g})"
+            )
+        else:
+            out.append(i)
+    return out
 
 
 def grid(
