@@ -164,7 +164,9 @@ def test_a_correct_model_is_called_adequate():
     assert str(verdict).startswith("the model describes the record")
     arx = clpc.ARX(order=2, nk=1, nb=1).fit(*record(8))
     assert arx.verdict().adequate is True
-    assert "no eigenvalue statistics" in str(arx.verdict())
+    assert "no eigenvalue statistics (least squares has no eigenvalue" in str(arx.verdict())
+    oe = clpc.OE(order=2, nk=1, nb=1).fit(*record(8))
+    assert "no eigenvalue statistics (output error has no eigenvalue" in str(oe.verdict())
 
 
 def test_evidence_round_trips_through_model_files(tmp_path):

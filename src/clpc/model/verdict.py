@@ -141,6 +141,14 @@ def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, An
     return msgs, found
 
 
+#: why a model has no eigenvalue statistics, by ``info["method"]``
+_NO_EIGENVALUES = {
+    "least-squares": "least squares has no eigenvalue structure to judge",
+    "output-error": "output error has no eigenvalue structure to judge",
+    "clpc-steady-state": "an average of CLPC windows: each window's statistics are in the trace",
+}
+
+
 def fit_verdict(model: Any, output: int = 0) -> Verdict:
     """The verdict of a fit (:meth:`clpc.LPC.fit`, :meth:`clpc.ARX.fit`) for one output."""
     info = model.info
@@ -148,11 +156,8 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
     stable, kind, said = _stability(model, output)
     if "n_null" not in info:  # e.g. least squares, or a CLPC steady-state model
         what = "no eigenvalue statistics" if words else "no fit statistics"
-        notes = (
-            *words,
-            f"{what} (a least-squares, averaged or loaded model)",
-            f"the model is {said}",
-        )
+        why = _NO_EIGENVALUES.get(str(info.get("method")), "a loaded or hand-built model")
+        notes = (*words, f"{what} ({why})", f"the model is {said}")
         return Verdict(
             0, True, False, stable, model.structure.nb + 1, notes, stability=kind, **found
         )
