@@ -129,11 +129,18 @@ def verdict_table(summary: dict[str, Any]) -> str:
         figs = ", ".join(str(f) for f in c["figures"]) or "-"
         columns = ("ramp", "rich") if "ramp" in c or "rich" in c else _other_columns(c)
         cells = [_cell(c, n, columns) for n in columns]
-        first: dict[str, Any] = next((c[n] for n in columns if n in c), {})
-        crit = first.get("criterion", "-").replace("|", "\\|")  # a cell: escape the bars
+        crit = _criteria(c, columns).replace("|", "\\|")  # a cell: escape the bars
         cells += ["-"] * (2 - len(cells))
         rows.append(f"| {c['paper']} | {cells[0]} | {cells[1]} | {figs} | {crit} |")
     return "\n".join(rows) + "\n"
+
+
+def _criteria(claim: dict[str, Any], columns: tuple[str, ...]) -> str:
+    """The claim's criterion, or each scenario's when they differ (e.g. a negative control)."""
+    crits = {n: claim[n]["criterion"] for n in columns if "criterion" in claim.get(n, {})}
+    if len(set(crits.values())) > 1:
+        return "; ".join(f"{n}: {v}" for n, v in crits.items())
+    return next(iter(crits.values()), "-")
 
 
 def _other_columns(claim: dict[str, Any]) -> tuple[str, ...]:
