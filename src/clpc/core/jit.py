@@ -137,9 +137,10 @@ _STAMP_INSTALLED = False
 _NOTICE: dict[str, Any] = {"installed": False, "said": False}
 
 #: The line written to standard error when clpc's kernels start compiling (not loading
-#: from numba's cache): the first use in a fresh environment takes 15-20 s.
+#: from numba's cache): the CLPC kernel takes 15-20 s on its first use in a fresh
+#: environment, the model's filter about 1 s.
 COMPILE_NOTICE = (
-    "clpc: compiling the CLPC kernel (first use in this environment, about 20 s; "
+    "clpc: compiling clpc's kernels (first use in this environment: up to about 20 s; "
     "cached for later runs)..."
 )
 
