@@ -4,6 +4,7 @@ failures redrawn here with their own error, nothing left running."""
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -98,11 +99,15 @@ def test_the_forked_process_ends_with_the_painter_even_on_an_error():
         os.waitpid(pid, os.WNOHANG)
 
 
-def test_off_by_environment_or_argument(monkeypatch):
+def test_off_by_environment_or_argument_and_by_default_off_linux(monkeypatch):
     monkeypatch.setenv("CLPC_PAINTER", "0")
     assert not Painter().enabled
-    monkeypatch.delenv("CLPC_PAINTER")
+    monkeypatch.setenv("CLPC_PAINTER", "1")
     assert Painter().enabled
+    monkeypatch.delenv("CLPC_PAINTER")
+    assert Painter().enabled == sys.platform.startswith("linux")
+    monkeypatch.setattr(sys, "platform", "darwin")
+    assert not Painter().enabled
     assert not Painter(enabled=False).enabled
 
 

@@ -7,8 +7,8 @@ filter while the caller goes on appraising the record on the other core; given t
 figures (:meth:`Painter.submit`), it forks once more and the two draw them in parallel
 (largest first, each to the less loaded process) while the caller writes the page. A
 figure that fails there is drawn again here, so its error is raised with its own
-traceback; without ``fork`` (Windows), with ``CLPC_PAINTER=0`` or ``enabled=False``,
-everything is drawn here.
+traceback; without ``fork`` (Windows), off Linux unless ``CLPC_PAINTER=1``, with
+``CLPC_PAINTER=0`` or ``enabled=False``, everything is drawn here.
 
 The jobs travel by pickle: a job is a module-level function and its arguments.
 """
@@ -141,8 +141,9 @@ class Painter:
     Parameters
     ----------
     enabled : bool, optional
-        Fork a process at :meth:`start`; default: where ``os.fork`` exists and
-        ``CLPC_PAINTER`` is not ``"0"``.
+        Fork a process at :meth:`start`. Default: ``CLPC_PAINTER=1`` turns it on wherever
+        ``os.fork`` exists, ``CLPC_PAINTER=0`` off; unset, on Linux only (on macOS a
+        forked child that touches system frameworks such as Accelerate may crash).
 
     Examples
     --------
@@ -156,7 +157,8 @@ class Painter:
 
     def __init__(self, enabled: bool | None = None) -> None:
         if enabled is None:
-            enabled = os.environ.get("CLPC_PAINTER", "1") != "0"
+            flag = os.environ.get("CLPC_PAINTER", "")
+            enabled = flag == "1" or (flag != "0" and sys.platform.startswith("linux"))
         self.enabled = bool(enabled and hasattr(os, "fork"))
         self._conn: Any = None
         self._pid: int | None = None

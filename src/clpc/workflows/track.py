@@ -441,7 +441,8 @@ def track_file(
         is open) and yields them on, e.g. to show a progress bar.
     fork_figures : bool
         Draw the report's figures in forked processes (:class:`clpc.report.painter.Painter`,
-        POSIX; ``CLPC_PAINTER=0`` turns it off): one imports matplotlib while the record is
+        Linux, or POSIX with ``CLPC_PAINTER=1``; ``CLPC_PAINTER=0`` turns it off): one
+        imports matplotlib while the record is
         appraised, then two draw on the machine's cores. ``clpc track`` does.
 
     Returns
