@@ -442,8 +442,8 @@ def track_file(
     fork_figures : bool
         Draw the report's figures in forked processes (:class:`clpc.report.painter.Painter`,
         Linux, or POSIX with ``CLPC_PAINTER=1``; ``CLPC_PAINTER=0`` turns it off): one
-        imports matplotlib while the record is
-        appraised, then two draw on the machine's cores. ``clpc track`` does.
+        imports matplotlib while the record is appraised, then two draw on the machine's
+        cores. ``clpc track`` does.
 
     Returns
     -------
