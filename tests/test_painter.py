@@ -142,3 +142,17 @@ def test_clpc_track_writes_the_same_files_with_and_without_the_painter(tmp_path)
                               "step.png", "bode.png", "pz.png"}  # fmt: skip
     for name, content in outs["0"].items():
         assert outs["1"][name] == content, name
+
+
+def test_a_failed_fork_draws_everything_here(tmp_path, monkeypatch):
+    import clpc.report.painter as painter_module
+
+    def no_fork() -> int:
+        raise OSError("Resource temporarily unavailable")
+
+    monkeypatch.setattr(painter_module, "_fork", no_fork)
+    with Painter(enabled=True) as painter:
+        painter.start()
+        assert not painter.forked and not painter.enabled
+        painter.draw([FigureJob(_write, (tmp_path / "here.txt", "x"))])
+    assert (tmp_path / "here.txt").read_text() == "x"

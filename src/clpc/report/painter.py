@@ -183,7 +183,13 @@ class Painter:
         from multiprocessing import Pipe
 
         mine, theirs = Pipe()
-        pid = _fork()
+        try:
+            pid = _fork()
+        except OSError:  # no process to spare (a limit, memory): everything drawn here
+            mine.close()
+            theirs.close()
+            self.enabled = False
+            return
         if pid == 0:
             mine.close()
             _serve(theirs)

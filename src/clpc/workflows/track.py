@@ -397,6 +397,10 @@ def _load_numba() -> None:
     """Import numba and set up its compiler (0.3 s, once per process) on a small filter."""
     try:
         from clpc.core.filters import all_pole
+        from clpc.core.jit import resolve_engine
+
+        if resolve_engine("auto") == "python":
+            return
 
         all_pole(np.array([1.0, -0.5]), np.ones(4))
     except Exception:  # the appraiser's own call says what is wrong
