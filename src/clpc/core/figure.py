@@ -6,7 +6,7 @@ alike. matplotlib is imported only when a figure is made (``pip install 'clpc[pl
 * :data:`COLORS` - one colour per quantity (measured, model output, residual, ...), the
   same in every figure.
 * :func:`new_figure` / :func:`axes_for` - a headless figure, or the caller's axes;
-  :class:`Margins` - fixed margins for a figure whose labels are known in advance.
+  :func:`new_grid` and :class:`Margins` - a figure on fixed margins (labels known ahead).
 * :func:`envelope` - min/max of a long signal over bins (vectorised), for drawing.
 * :func:`draw_signal` - a line, or its min/max band when there are too many points.
 * :func:`time_label` / :func:`place_legend`.
@@ -57,37 +57,22 @@ COLORS: dict[str, str] = {
 MAX_POINTS = 4000
 
 
-def new_figure(
-    n_rows: int = 1,
-    n_cols: int = 1,
-    *,
-    height: float = 2.6,
-    width: float = 8.0,
-    margins: Margins | None = None,
-):
+def new_figure(n_rows: int = 1, n_cols: int = 1, *, height: float = 2.6, width: float = 8.0):
     """A new Agg-backed figure (no pyplot state) and its axes, shape (n_rows, n_cols).
 
-    Parameters
-    ----------
-    n_rows, n_cols : int
-        Axes grid.
-    height, width : float
-        Height per row and width of the figure [in] (0.7 in more for the title).
-    margins : Margins, optional
-        Fixed margins and gaps; by default matplotlib's constrained layout places the axes
-        (it measures every tick label, about a third of a figure's drawing time).
+    ``height`` per row and ``width`` in inches (0.7 in more for the title); matplotlib's
+    constrained layout places the axes.
     """
-    fig = _figure((width, 0.7 + height * n_rows), constrained=margins is None)
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
-    if margins is not None:
-        margins.apply(fig, n_rows, n_cols)
-    return fig, axes
+    fig = _figure((width, 0.7 + height * n_rows), constrained=True)
+    return fig, fig.subplots(n_rows, n_cols, squeeze=False)
 
 
 def new_grid(n_rows: int, n_cols: int, margins: Margins, *, height: float, width: float = 8.0):
-    """A new Agg-backed figure and an empty grid (``GridSpec``) placed by ``margins``.
+    """A new Agg-backed figure and an empty grid (``GridSpec``) placed by fixed ``margins``.
 
-    For figures whose axes span cells (see :func:`new_figure` for the sizes).
+    For a figure whose labels are known in advance and whose axes may span cells: no
+    constrained layout (it measures every tick label, about a third of the drawing time).
+    Sizes as for :func:`new_figure`.
     """
     fig = _figure((width, 0.7 + height * n_rows), constrained=False)
     return fig, fig.add_gridspec(n_rows, n_cols, **margins.fractions(fig, n_rows, n_cols))
@@ -106,19 +91,14 @@ def _figure(size: tuple[float, float], *, constrained: bool) -> Any:
 
 @dataclass(frozen=True)
 class Margins:
-    """Fixed figure margins and gaps between axes [in], for figures of a known layout.
+    """Fixed figure margins and gaps between axes [in] (see :func:`new_grid`)."""
 
-    A figure whose labels are known in advance (e.g. :func:`clpc.plotting.plot_trace`)
-    is placed by these instead of the constrained layout, which costs a third of its
-    drawing time.
-    """
-
-    left: float = 0.95
-    right: float = 0.2
-    top: float = 0.75
-    bottom: float = 0.55
-    row_gap: float = 0.7
-    col_gap: float = 0.95
+    left: float
+    right: float
+    top: float
+    bottom: float
+    row_gap: float
+    col_gap: float
 
     def fractions(self, fig: Any, n_rows: int, n_cols: int) -> dict[str, float]:
         """``left, right, top, bottom, hspace, wspace`` of a grid of axes in ``fig``."""
@@ -133,10 +113,6 @@ class Margins:
             "hspace": self.row_gap / max(axes_h, 1e-3),
             "wspace": self.col_gap / max(axes_w, 1e-3),
         }
-
-    def apply(self, fig: Any, n_rows: int, n_cols: int) -> None:
-        """Place ``fig``'s grid of ``n_rows`` x ``n_cols`` axes."""
-        fig.subplots_adjust(**self.fractions(fig, n_rows, n_cols))
 
 
 def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tuple[Any, list]:
