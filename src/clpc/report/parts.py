@@ -87,6 +87,10 @@ def fit_table(summary: Mapping[str, Any]) -> list[list[Any]]:
     return rows
 
 
+#: relative drawing time of one panel of a multi-panel figure (a fit figure of one output
+#: has two; the Bode figure, about 0.2 s, costs 1.5)
+PANEL_COST = 0.5
+
 #: the figures of :func:`model_sections`, in its order
 FIT_PNG, DATA_PNG, STEP_PNG = "fit.png", "data.png", "step.png"
 BODE_PNG, PZ_PNG = "bode.png", "pz.png"
@@ -98,15 +102,23 @@ def model_figures(
     """The figures of :func:`model_sections`, as jobs (for :class:`~clpc.report.painter.Painter`).
 
     ``fit.png`` and ``data.png`` (with ``data``), ``step.png``, ``bode.png``, ``pz.png`` in
-    ``out``; ``cost`` is each one's relative drawing time.
+    ``out``; ``cost`` is each one's relative drawing time (about :data:`PANEL_COST` per
+    panel of a figure with several).
     """
     jobs: list[FigureJob] = []
     if data is not None:
         title = f"the compared {data.n_samples} samples"
+        panels = data.n_inputs + data.n_outputs
         jobs += [
-            FigureJob(plot_fit, (model, data, out / FIT_PNG), {"t0": data_t0}, cost=1.0),
-            FigureJob(plot_data, (data, out / DATA_PNG), {"t0": data_t0, "title": title}, 0.8),
-        ]
+            FigureJob(
+                plot_fit, (model, data, out / FIT_PNG), {"t0": data_t0},
+                cost=PANEL_COST * 2 * model.n_outputs,
+            ),
+            FigureJob(
+                plot_data, (data, out / DATA_PNG), {"t0": data_t0, "title": title},
+                cost=PANEL_COST * 0.8 * panels,
+            ),
+        ]  # fmt: skip
     jobs += [
         FigureJob(plot_step, (model, out / STEP_PNG), cost=0.5),
         FigureJob(plot_bode, (model, out / BODE_PNG), cost=1.5),

@@ -17,9 +17,11 @@ from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
+from clpc.plotting.traces import trace_panels
 from clpc.report.html import Section, write_html_report
 from clpc.report.painter import FigureJob, Painter
 from clpc.report.parts import (
+    PANEL_COST,
     fit_warnings,
     model_figures,
     model_sections,
@@ -142,7 +144,8 @@ def write_track_report(
     trace_png = out / "trace.png"
     jobs = [] if model is None else model_figures(model, out, data=data, data_t0=data_t0)
     title_png = f"CLPC trace: {len(trace)} updates"
-    jobs.append(FigureJob(plot_trace, (trace, trace_png), {"title": title_png}, cost=2.0))
+    cost = 0.6 * PANEL_COST * trace_panels(trace)  # 2.1 for one output of order 2
+    jobs.append(FigureJob(plot_trace, (trace, trace_png), {"title": title_png}, cost=cost))
     painter = Painter(enabled=False) if painter is None else painter
     painter.submit(jobs)  # drawn meanwhile when the painter forked, else by wait() below
     summary = trace_summary(trace) if summary is None else summary
