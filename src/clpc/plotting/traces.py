@@ -117,6 +117,10 @@ def plot_trace(
         draw_signal(ax_d, t, d, color=COLORS["D"], label="D")
         if np.any(np.isfinite(d)):
             ax_d.set_yscale("log")
+            if np.nanmax(d) >= 10.0 * np.nanmin(d):  # a decade or more: its powers of 10 are
+                from matplotlib.ticker import NullFormatter  # labelled, the rest would crowd
+
+                ax_d.yaxis.set_minor_formatter(NullFormatter())
         accepted = np.asarray(trace.arrays["accepted"][:, e], dtype=bool)
         determined = np.asarray(trace.arrays["determined"][:, e], dtype=bool)
         _mark(ax_d, t, d, ~accepted, "not accepted", "x")
