@@ -193,14 +193,13 @@ class TraceWriter:
 
     def close(self) -> None:
         """Finish the writes, flush and close the file (an error of a write is raised)."""
-        pending, self._pending = self._pending, None
-        if self._pool is not None:
-            self._pool.shutdown(wait=True)
-            self._pool = None
-        if pending is not None and pending.exception() is not None:
+        try:
+            self.drain()
+        finally:
+            if self._pool is not None:
+                self._pool.shutdown(wait=True)
+                self._pool = None
             self._close_files()
-            raise pending.exception()  # type: ignore[misc]
-        self._close_files()
 
     def _close_files(self) -> None:
         if self._fh is not None:

@@ -169,10 +169,8 @@ def infer_input(
             )
         past = past[past.size - s.na :]
     y_ext = np.concatenate([past, yv])
-    from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
-    w = signal.lfilter(model.den, [1.0], y_ext)[s.na :] - model.intercept[0]
-    u_hat = signal.lfilter([1.0], num, w)
+    w = fir(model.den, y_ext)[s.na :] - model.intercept[0]
+    u_hat = all_pole(num, w)
     return u_hat[s.nk :] if s.nk else u_hat
 
 

@@ -163,7 +163,6 @@ class Painter:
         self._conn: Any = None
         self._pid: int | None = None
         self._jobs: list[FigureJob] = []
-        self._sent = False
         self._sender: threading.Thread | None = None
         self._send_error: Exception | None = None
 
@@ -203,13 +202,11 @@ class Painter:
         while the forked process finishes its warm-up and reads them.
         """
         self._jobs = list(jobs)
-        self._sent = False
         if self._conn is not None and self._jobs:
             self._sender = threading.Thread(
                 target=self._send, args=(self._jobs,), name="clpc-painter-send"
             )
             self._sender.start()
-            self._sent = True
 
     def _send(self, jobs: list[FigureJob]) -> None:
         try:
@@ -228,14 +225,13 @@ class Painter:
         """
         jobs, failed = self._jobs, list(range(len(self._jobs)))
         self._jobs = []
-        if self._sender is not None:
-            self._sender.join()
-            self._sender = None
+        sent, self._sender = self._sender, None
+        if sent is not None:
+            sent.join()
         if self._send_error is not None:
             self._send_error = None
             self.close(kill=True)
-        if self._sent and self._conn is not None:
-            self._sent = False
+        if sent is not None and self._conn is not None:
             try:
                 if self._conn.poll(TIMEOUT):
                     failed = list(self._conn.recv())
