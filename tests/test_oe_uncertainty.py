@@ -32,7 +32,7 @@ def _output_noise(seed: int, n: int, sd: float = 0.5) -> tuple[np.ndarray, np.nd
 
 def test_oe_intervals_are_calibrated_on_output_noise_records():
     # 200 fixed seeds, short records (N = 200): each true parameter inside its 95 % interval
-    # in 90-99 % of the records (benchmarks/uncertainty.py: 0.953-0.977 over 1000 seeds)
+    # in 90-99 % of the records (benchmarks/uncertainty.py: 0.952-0.970 over 1000 seeds)
     hits = []
     for seed in range(200):
         u, y = _output_noise(seed, 200)
@@ -48,35 +48,40 @@ def _segments(n: int, s: int) -> list[int]:
     return [s + int(np.round(i * (n - s) / k)) for i in range(k)] + [n]
 
 
-def _simulation_error(model, u, y, p, k, starts):
-    """Segment free-run errors of the model with monic parameters ``p = [a1, a2, b0, b1, b2]``.
+def _runs(n: int, s: int) -> list[tuple[int, int]]:
+    """(first, end) of each free run: one over the whole record, then each later segment."""
+    b = _segments(n, s)
+    return [(b[0], n)] + [(b[i], b[i + 1]) for i in range(1, len(b) - 1)]
 
-    ``starts[i]``: the two start values ``y(b_i - 2), y(b_i - 1)`` of segment ``i``.
+
+def _simulation_error(model, u, y, p, k, starts):
+    """Free-run errors of every run of the model with monic parameters ``p = [a1, a2, b0, b1, b2]``.
+
+    ``starts[i]``: the two start values ``y(b_i - 2), y(b_i - 1)`` of run ``i``.
     """
     theta = np.r_[1.0, p[:2], -p[2:]]
     scale = np.linalg.norm(theta)
     m = replace(model, theta=theta / scale, c=k / scale)
-    b = _segments(y.size, 2)
     return np.concatenate(
         [
-            y[b[i] : b[i + 1]]
-            - m.simulate(u[b[i] : b[i + 1]], y_init=starts[i], u_init=u[b[i] - 2 : b[i]])
-            for i in range(len(b) - 1)
+            y[first:end] - m.simulate(u[first:end], y_init=starts[i], u_init=u[first - 2 : first])
+            for i, (first, end) in enumerate(_runs(y.size, 2))
         ]
     )
 
 
 def test_oe_covariance_equals_a_finite_difference_recomputation():
     # independent of OE's analytic Jacobian, its reflection parametrisation and monic_map:
-    # C = s^2 (J^T J)^-1 J^T (I - G S)(I - G S)^T J (J^T J)^-1 + (first start's sandwich):
-    # J and G (the errors' response to each segment's measured start values) by differences;
-    # S: the start values of a later segment are samples of the errors themselves
+    # C = s^2 (J^T J)^-1 J^T (P - G S)(P - G S)^T J (J^T J)^-1 + (first start's sandwich):
+    # J and G (the errors' response to each run's measured start values) by differences;
+    # P: each error row's noise sample (a sample in two runs counts twice); S: the start
+    # values of a later run are noise samples themselves
     u, y = _output_noise(3, 300)
     model = clpc.OE(order=2, assess=False).fit(u, y)
     p0, k0 = np.r_[model.den[1:], model.num], float(model.intercept[0])
-    b = _segments(y.size, 2)
-    assert len(b) == 5  # four segments
-    starts = np.array([y[x - 2 : x] for x in b[:-1]])
+    runs = _runs(y.size, 2)
+    assert len(runs) == 4  # the whole record and three later segments
+    starts = np.array([y[first - 2 : first] for first, _ in runs])
     r0 = _simulation_error(model, u, y, p0, k0, starts)
     h = 1e-6
     cols = []
@@ -94,14 +99,16 @@ def test_oe_covariance_equals_a_finite_difference_recomputation():
             )
             - r0
         )
-    sel = np.zeros((starts.size, r0.size))  # S: start value (segment i, lag) <- error row
-    for i in range(1, len(b) - 1):
+    times = np.concatenate([np.arange(first, end) for first, end in runs]) - 2
+    pick = np.eye(y.size - 2)[times]  # P: error row <- its noise sample (times 2 .. T-1)
+    sel = np.zeros((starts.size, y.size - 2))  # S: start value (run i, lag) <- noise sample
+    for i in range(1, len(runs)):
         for lag in range(2):
-            sel[2 * i + lag, b[i] - 2 + lag - 2] = 1.0
-    dof = r0.size - 6
-    s2 = float(r0 @ r0) / dof
+            sel[2 * i + lag, runs[i][0] - 2 + lag - 2] = 1.0
+    dof = y.size - 2 - 6  # the noise variance from the first run: every sample once
+    s2 = float(r0[: y.size - 2] @ r0[: y.size - 2]) / dof
     inv = np.linalg.inv(jac.T @ jac)
-    w = jac.T @ (np.eye(r0.size) - g @ sel)
+    w = jac.T @ (pick - g @ sel)
     h0 = inv @ jac.T @ g[:, :2]
     cov = s2 * inv @ w @ w.T @ inv + s2 * h0 @ h0.T
     np.testing.assert_allclose(model.info["covariance"], cov[:5, :5], rtol=1e-4)

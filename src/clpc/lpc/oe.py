@@ -3,14 +3,15 @@
 For each output ``j`` the model ``A(q) y_j = sum_i B_i(q) u_i + k`` (common monic ``A``, one
 ``B_i`` per input, ``nk`` leading zeros) is chosen to minimise the free-run simulation error
 
-    sum_n (y_j(n) - y_hat_j(n))^2,     n = max_lag .. T-1,
+    sum_r sum_n (y_j(n) - y_hat_jr(n))^2,     n = first_r .. end_r - 1,
 
-where ``y_hat`` is simulated from the input alone over up to four consecutive segments of
-the record, each started from the measured outputs just before it (so a record that does
-not start at rest is fitted exactly; why several starts: :mod:`clpc.lpc.simulation_error`,
-which holds the residual, Jacobian and covariance). Least squares
-(:class:`clpc.ARX`) minimises the one-step equation error instead; with white noise on the
-output only, that is biased and the simulation error is not.
+where each run ``y_hat_jr`` is simulated from the input alone, once over the whole record
+and once more from each later start of up to four consecutive segments, every run started
+from the measured outputs just before it (so a record that does not start at rest is fitted
+exactly; why these runs: :mod:`clpc.lpc.simulation_error`, which holds the residual,
+Jacobian and covariance). Least squares (:class:`clpc.ARX`) minimises the one-step equation
+error instead; with white noise on the output only, that is biased and the simulation error
+is not.
 
 * **Stable by construction.** ``A`` is parametrised by its reflection coefficients
   ``kappa_m = MAX_KAPPA tanh(rho_m)`` (the Levinson step-up recursion): every ``rho`` gives a
@@ -22,7 +23,7 @@ output only, that is biased and the simulation error is not.
   smaller simulation error is kept (``info["start"]``).
 * **Analytic Jacobian.** ``d y_hat / d a_l = -y_hat(n-l) / A(q)``, ``d y_hat / d b_il =
   u_i(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``: one ``lfilter`` over all columns and
-  segments, no loop over samples.
+  runs of equal length, no loop over samples.
 """
 
 from __future__ import annotations
@@ -59,6 +60,10 @@ class OE:
         Most measured starts of the simulation error (default
         :data:`~clpc.lpc.simulation_error.SEGMENTS`; 1: one free run over the record). See
         :mod:`clpc.lpc.simulation_error` for why.
+    full_run : bool
+        The first run goes on over the whole record (default ``True``); ``False``: every
+        segment is run on its own (multiple shooting), which lets a near-integrator that fits
+        each segment drift over longer runs.
     starts : tuple of {"arx", "lpc"}
         The closed-form fits that start the search (default both).
     initial : LinearModel, optional
@@ -78,10 +83,10 @@ class OE:
     -----
     The fit is local: it improves on the best of its starts and can stop in a local
     minimum. ``info`` holds per output ``start`` (which start won: ``"arx"``, ``"lpc"`` or
-    ``"initial"``), ``cost`` (``sum of squared simulation errors / 2``), ``start_costs``
-    (the final cost from each start), ``nfev`` and ``success``; ``info["noise_model"] =
-    "output-error"`` (white noise on the output: the model's ``k``-step predictor is its
-    free run, :meth:`LinearModel.predict`).
+    ``"initial"``), ``cost`` (``sum of squared simulation errors of every run / 2``),
+    ``start_costs`` (the final cost from each start), ``nfev`` and ``success``;
+    ``info["noise_model"] = "output-error"`` (white noise on the output: the model's
+    ``k``-step predictor is its free run, :meth:`LinearModel.predict`).
     """
 
     order: int = 2
@@ -91,6 +96,7 @@ class OE:
     mimo: MimoMode | None = None
     max_nfev: int = 200
     segments: int = SEGMENTS
+    full_run: bool = True
     starts: tuple[str, ...] = ("arx", "lpc")
     initial: LinearModel | None = None
     uncertainty: bool = True
@@ -123,6 +129,8 @@ class OE:
         """
         if not isinstance(self.max_nfev, int) or self.max_nfev < 1:
             raise ValueError(f"max_nfev must be an int >= 1; got {self.max_nfev!r}.")
+        if not isinstance(self.full_run, bool):
+            raise ValueError(f"full_run must be True or False; got {self.full_run!r}.")
         if not isinstance(self.segments, int) or self.segments < 1:
             raise ValueError(f"segments must be an int >= 1; got {self.segments!r}.")
         unknown = set(self.starts) - {"arx", "lpc"}
@@ -156,6 +164,7 @@ class OE:
                 structure.na,
                 structure.max_lag,
                 self.segments,
+                self.full_run,
             )
             fits = {}
             for name, model in starts.items():
