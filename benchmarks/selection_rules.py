@@ -40,13 +40,15 @@ Usage::
     python benchmarks/selection_rules.py [--splits bench,half,reversed,sim,seventy,sim2]
         [--cache DIR] [--identify] [--detail RULE]
 
-Fits are cached in ``--cache`` (default ``/tmp/clpc-selection-rules``) per split; delete it
-after changing an estimator.
+Fits are cached per split in ``--cache`` (default ``/tmp/clpc-selection-rules/<key>``, the key
+a hash of the source of ``clpc.lpc`` imported: a changed estimator gets new fits; with an
+explicit ``--cache``, delete it after changing an estimator).
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import math
 import pickle
 import sys
@@ -324,16 +326,26 @@ def identify_rows(recs: list) -> list[list[str]]:
     return picks
 
 
+def source_key() -> str:
+    """A short hash of the estimators' source (``clpc/lpc/*.py`` of the clpc imported)."""
+    digest = hashlib.sha256()
+    for path in sorted((Path(clpc.__file__).parent / "lpc").glob("*.py")):
+        digest.update(path.name.encode() + path.read_bytes())
+    return digest.hexdigest()[:12]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--splits", default="bench,half,reversed,sim,seventy,sim2")
-    ap.add_argument("--cache", type=Path, default=Path("/tmp/clpc-selection-rules"))
+    ap.add_argument("--cache", type=Path, default=None)
     ap.add_argument("--no-guard", action="store_true", help="no fallback from an unstable refit")
     ap.add_argument("--detail", action="append", default=[], help="print a rule's misses")
     ap.add_argument(
         "--identify", action="store_true", help="also score clpc.identify of this checkout"
     )
     args = ap.parse_args(argv)
+    if args.cache is None:
+        args.cache = Path("/tmp/clpc-selection-rules") / source_key()
     args.cache.mkdir(parents=True, exist_ok=True)
     data = {}
     for split in args.splits.split(","):

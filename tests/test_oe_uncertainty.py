@@ -13,6 +13,7 @@ import clpc
 import clpc.datasets as ds
 from clpc.cli import cli
 from clpc.lpc import comparison
+from clpc.lpc.simulation_error import MIN_SEGMENT, SEGMENTS
 from clpc.model import ModelError
 from clpc.report.summaries import model_summary
 from clpc.report.text import estimator_name, format_model_summary
@@ -31,7 +32,7 @@ def _output_noise(seed: int, n: int, sd: float = 0.5) -> tuple[np.ndarray, np.nd
 
 def test_oe_intervals_are_calibrated_on_output_noise_records():
     # 200 fixed seeds, short records (N = 200): each true parameter inside its 95 % interval
-    # in 90-99 % of the records (benchmarks/uncertainty.py: 0.947-0.959 over 1000 seeds)
+    # in 90-99 % of the records (benchmarks/uncertainty.py: 0.952-0.970 over 1000 seeds)
     hits = []
     for seed in range(200):
         u, y = _output_noise(seed, 200)
@@ -41,39 +42,75 @@ def test_oe_intervals_are_calibrated_on_output_noise_records():
     assert np.all((cover >= 0.90) & (cover <= 0.99)), cover
 
 
-def _simulation_error(model, u, y, p, k, y_start):
-    """Free-run error of the model with monic parameters ``p = [a1, a2, b0, b1, b2]``."""
+def _segments(n: int, s: int) -> list[int]:
+    """Segment starts of OE's simulation error (clpc.lpc.simulation_error, its stated rule)."""
+    k = max(1, min(SEGMENTS, (n - s) // MIN_SEGMENT))
+    return [s + int(np.round(i * (n - s) / k)) for i in range(k)] + [n]
+
+
+def _runs(n: int, s: int) -> list[tuple[int, int]]:
+    """(first, end) of each free run: one over the whole record, then each later segment."""
+    b = _segments(n, s)
+    return [(b[0], n)] + [(b[i], b[i + 1]) for i in range(1, len(b) - 1)]
+
+
+def _simulation_error(model, u, y, p, k, starts):
+    """Free-run errors of every run of the model with monic parameters ``p = [a1, a2, b0, b1, b2]``.
+
+    ``starts[i]``: the two start values ``y(b_i - 2), y(b_i - 1)`` of run ``i``.
+    """
     theta = np.r_[1.0, p[:2], -p[2:]]
     scale = np.linalg.norm(theta)
     m = replace(model, theta=theta / scale, c=k / scale)
-    return y[2:] - m.simulate(u[2:], y_init=y_start, u_init=u[:2])
+    return np.concatenate(
+        [
+            y[first:end] - m.simulate(u[first:end], y_init=starts[i], u_init=u[first - 2 : first])
+            for i, (first, end) in enumerate(_runs(y.size, 2))
+        ]
+    )
 
 
 def test_oe_covariance_equals_a_finite_difference_recomputation():
     # independent of OE's analytic Jacobian, its reflection parametrisation and monic_map:
-    # C = s^2 (J^T J)^-1 + (sandwich of the noisy start values), J and G by differences
+    # C = s^2 (J^T J)^-1 J^T (P - G S)(P - G S)^T J (J^T J)^-1 + (first start's sandwich):
+    # J and G (the errors' response to each run's measured start values) by differences;
+    # P: each error row's noise sample (a sample in two runs counts twice); S: the start
+    # values of a later run are noise samples themselves
     u, y = _output_noise(3, 300)
     model = clpc.OE(order=2, assess=False).fit(u, y)
     p0, k0 = np.r_[model.den[1:], model.num], float(model.intercept[0])
-    r0 = _simulation_error(model, u, y, p0, k0, y[:2])
+    runs = _runs(y.size, 2)
+    assert len(runs) == 4  # the whole record and three later segments
+    starts = np.array([y[first - 2 : first] for first, _ in runs])
+    r0 = _simulation_error(model, u, y, p0, k0, starts)
     h = 1e-6
     cols = []
     for i in range(6):
         step = np.eye(6)[i] * h
-        plus = _simulation_error(model, u, y, p0 + step[:5], k0 + step[5], y[:2])
-        minus = _simulation_error(model, u, y, p0 - step[:5], k0 - step[5], y[:2])
+        plus = _simulation_error(model, u, y, p0 + step[:5], k0 + step[5], starts)
+        minus = _simulation_error(model, u, y, p0 - step[:5], k0 - step[5], starts)
         cols.append((plus - minus) / (2 * h))
     jac = np.column_stack(cols)
-    g = np.column_stack(
-        [
-            (_simulation_error(model, u, y, p0, k0, y[:2] + e) - r0)
-            for e in np.eye(2)  # linear in the start values: one-sided is exact
-        ]
-    )
-    dof = r0.size - 6
-    s2 = float(r0 @ r0) / dof
+    g = np.zeros((r0.size, starts.size))  # linear in the start values: one-sided is exact
+    for c in range(starts.size):
+        g[:, c] = -(
+            _simulation_error(
+                model, u, y, p0, k0, starts + np.eye(starts.size)[c].reshape(starts.shape)
+            )
+            - r0
+        )
+    times = np.concatenate([np.arange(first, end) for first, end in runs]) - 2
+    pick = np.eye(y.size - 2)[times]  # P: error row <- its noise sample (times 2 .. T-1)
+    sel = np.zeros((starts.size, y.size - 2))  # S: start value (run i, lag) <- noise sample
+    for i in range(1, len(runs)):
+        for lag in range(2):
+            sel[2 * i + lag, runs[i][0] - 2 + lag - 2] = 1.0
+    dof = y.size - 2 - 6  # the noise variance from the first run: every sample once
+    s2 = float(r0[: y.size - 2] @ r0[: y.size - 2]) / dof
     inv = np.linalg.inv(jac.T @ jac)
-    cov = s2 * inv + s2 * inv @ jac.T @ g @ g.T @ jac @ inv
+    w = jac.T @ (pick - g @ sel)
+    h0 = inv @ jac.T @ g[:, :2]
+    cov = s2 * inv @ w @ w.T @ inv + s2 * h0 @ h0.T
     np.testing.assert_allclose(model.info["covariance"], cov[:5, :5], rtol=1e-4)
     assert model.info["covariance_dof"] == dof
     assert model.info["noise_model"] == "output-error"

@@ -3,12 +3,15 @@
 For each output ``j`` the model ``A(q) y_j = sum_i B_i(q) u_i + k`` (common monic ``A``, one
 ``B_i`` per input, ``nk`` leading zeros) is chosen to minimise the free-run simulation error
 
-    sum_n (y_j(n) - y_hat_j(n))^2,     n = max_lag .. T-1,
+    sum_r sum_n (y_j(n) - y_hat_jr(n))^2,     n = first_r .. end_r - 1,
 
-where ``y_hat`` is simulated from the input alone, started from the measured outputs before
-``max_lag`` (so a record that does not start at rest is fitted exactly). Least squares
-(:class:`clpc.ARX`) minimises the one-step equation error instead; with white noise on the
-output only, that is biased and the simulation error is not.
+where each run ``y_hat_jr`` is simulated from the input alone, once over the whole record
+and once more from each later start of up to four consecutive segments, every run started
+from the measured outputs just before it (so a record that does not start at rest is fitted
+exactly; why these runs: :mod:`clpc.lpc.simulation_error`, which holds the residual,
+Jacobian and covariance). Least squares (:class:`clpc.ARX`) minimises the one-step equation
+error instead; with white noise on the output only, that is biased and the simulation error
+is not.
 
 * **Stable by construction.** ``A`` is parametrised by its reflection coefficients
   ``kappa_m = MAX_KAPPA tanh(rho_m)`` (the Levinson step-up recursion): every ``rho`` gives a
@@ -19,8 +22,8 @@ output only, that is biased and the simulation error is not.
   start is first made stable by reflecting its poles ``z -> 1/conj(z)``. The fit with the
   smaller simulation error is kept (``info["start"]``).
 * **Analytic Jacobian.** ``d y_hat / d a_l = -y_hat(n-l) / A(q)``, ``d y_hat / d b_il =
-  u_i(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``: one ``lfilter`` over all columns, no
-  loop over samples.
+  u_i(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``: one ``lfilter`` over all columns and
+  runs of equal length, no loop over samples.
 """
 
 from __future__ import annotations
@@ -34,92 +37,13 @@ from clpc.data import DataError, IOData, as_iodata
 from clpc.lpc import assessment
 from clpc.lpc.arx import ARX
 from clpc.lpc.estimator import LPC
-from clpc.lpc.reflection import MAX_KAPPA, poly_from_reflection, reflection_from_poly
+from clpc.lpc.reflection import MAX_KAPPA, reflection_from_poly
 from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, lagged
-from clpc.lpc.uncertainty import (
-    covariance_from_jacobian,
-    monic_map,
-    with_covariance,
-    without_covariance,
-)
+from clpc.lpc.simulation_error import SEGMENTS, SimulationError
+from clpc.lpc.uncertainty import monic_map, with_covariance, without_covariance
 from clpc.model import LinearModel, ModelError
 
 __all__ = ["OE"]
-
-
-@dataclass
-class _Problem:
-    """One output's simulation-error problem (rows ``n = s .. T-1``)."""
-
-    y: np.ndarray  # (T,) measured output
-    phi_u: np.ndarray  # (T - s, m (nb + 1)) input lags u_i(n - nk - l)
-    na: int
-    s: int  # first simulated sample (max_lag)
-
-    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-        """``x = [rho (na); b; k]`` -> ``a``, ``da/drho``, ``b``, ``k``."""
-        t = np.tanh(x[: self.na])
-        a, da = poly_from_reflection(MAX_KAPPA * t)
-        return a, da[1:] * (MAX_KAPPA * (1.0 - t**2))[None, :], x[self.na : -1], float(x[-1])
-
-    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``a`` and ``y_hat(n)`` for ``n >= s``, started from the measured ``y`` before ``s``."""
-        a, _, b, k = self.split(x)
-        forced = self.phi_u @ b + k
-        past = self.y[self.s - self.na : self.s][::-1]  # y(s-1), y(s-2), ..., y(s-na)
-        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
-        zi = signal.lfiltic([1.0], a, past)
-        return a, signal.lfilter([1.0], a, forced, zi=zi)[0]
-
-    def residual(self, x: np.ndarray) -> np.ndarray:
-        return self.y[self.s :] - self.simulate(x)[1]
-
-    def monic_jacobian(self, x: np.ndarray) -> np.ndarray:
-        """``d residual / d (a_1..a_na, b, k)``, shape (T - s, na + len(b) + 1)."""
-        a, _, _, _ = self.split(x)
-        _, y_hat = self.simulate(x)
-        full = np.concatenate([self.y[: self.s], y_hat])
-        y_lags = lagged(full, self.na - 1, 1, self.s)  # y_hat(n-1) .. y_hat(n-na)
-        cols = np.hstack([-y_lags, self.phi_u, np.ones((y_hat.size, 1))])
-        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
-        return -signal.lfilter([1.0], a, cols, axis=0)  # -(d y_hat / d (a, b, k))
-
-    def jacobian(self, x: np.ndarray) -> np.ndarray:
-        """``d residual / d x`` (``x = [rho; b; k]``: the chain rule through ``a(rho)``)."""
-        _, da_drho, _, _ = self.split(x)
-        jac = self.monic_jacobian(x)
-        return np.hstack([jac[:, : self.na] @ da_drho, jac[:, self.na :]])
-
-    def covariance(self, x: np.ndarray, lmap: np.ndarray) -> tuple[np.ndarray, int]:
-        """Covariance of the monic vector of this output at the optimum ``x`` (see OE).
-
-        ``s^2 (J^T J)^-1`` with ``J`` taken with respect to ``(a_1..a_na, b, k)`` directly
-        (not ``rho``: its ``tanh`` flattens near the stability bound); the ``(a, b)`` block
-        is carried to ``np.r_[den[1:], num]`` by ``lmap`` (:func:`monic_map`, with the sign
-        of ``b`` flipped: here ``num = +b``).
-        """
-        jac, res = self.monic_jacobian(x), self.residual(x)
-        cov, dof = covariance_from_jacobian(jac, res)
-        # the simulation starts from the measured (noisy) y(s-1..s-na): their noise, white
-        # like the output's, moves the estimate by -(J^T J)^-1 J^T G delta (G: the free
-        # response to each start value), which the sandwich adds.
-        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
-        a, zeros = self.split(x)[0], np.zeros(res.size)
-        g = np.column_stack(
-            [
-                signal.lfilter([1.0], a, zeros, zi=signal.lfiltic([1.0], a, past))[0]
-                for past in np.eye(self.na)  # a unit y(s-1-i), the others 0
-            ]
-        )
-        h = cov @ (jac.T @ g)
-        cov = cov + h @ h.T / (float(res @ res) / dof)
-        n_ab = cov.shape[0] - 1  # drop the offset k
-        flip = np.r_[np.ones(self.na), -np.ones(n_ab - self.na)]
-        cov_x = flip[:, None] * cov[:n_ab, :n_ab] * flip[None, :]
-        return lmap @ cov_x @ lmap.T, dof
 
 
 @dataclass
@@ -132,6 +56,14 @@ class OE:
         As for :class:`clpc.LPC` (same structure, same :class:`~clpc.model.LinearModel`).
     max_nfev : int
         Most residual evaluations per start (Levenberg-Marquardt).
+    segments : int
+        Most measured starts of the simulation error (default
+        :data:`~clpc.lpc.simulation_error.SEGMENTS`; 1: one free run over the record). See
+        :mod:`clpc.lpc.simulation_error` for why.
+    full_run : bool
+        The first run goes on over the whole record (default ``True``); ``False``: every
+        segment is run on its own (multiple shooting), which lets a near-integrator that fits
+        each segment drift over longer runs.
     starts : tuple of {"arx", "lpc"}
         The closed-form fits that start the search (default both).
     initial : LinearModel, optional
@@ -151,10 +83,10 @@ class OE:
     -----
     The fit is local: it improves on the best of its starts and can stop in a local
     minimum. ``info`` holds per output ``start`` (which start won: ``"arx"``, ``"lpc"`` or
-    ``"initial"``), ``cost`` (``sum of squared simulation errors / 2``), ``start_costs``
-    (the final cost from each start), ``nfev`` and ``success``; ``info["noise_model"] =
-    "output-error"`` (white noise on the output: the model's ``k``-step predictor is its
-    free run, :meth:`LinearModel.predict`).
+    ``"initial"``), ``cost`` (``sum of squared simulation errors of every run / 2``),
+    ``start_costs`` (the final cost from each start), ``nfev`` and ``success``;
+    ``info["noise_model"] = "output-error"`` (white noise on the output: the model's
+    ``k``-step predictor is its free run, :meth:`LinearModel.predict`).
     """
 
     order: int = 2
@@ -163,6 +95,8 @@ class OE:
     nk: int = 0
     mimo: MimoMode | None = None
     max_nfev: int = 200
+    segments: int = SEGMENTS
+    full_run: bool = True
     starts: tuple[str, ...] = ("arx", "lpc")
     initial: LinearModel | None = None
     uncertainty: bool = True
@@ -195,6 +129,10 @@ class OE:
         """
         if not isinstance(self.max_nfev, int) or self.max_nfev < 1:
             raise ValueError(f"max_nfev must be an int >= 1; got {self.max_nfev!r}.")
+        if not isinstance(self.full_run, bool):
+            raise ValueError(f"full_run must be True or False; got {self.full_run!r}.")
+        if not isinstance(self.segments, int) or self.segments < 1:
+            raise ValueError(f"segments must be an int >= 1; got {self.segments!r}.")
         unknown = set(self.starts) - {"arx", "lpc"}
         if unknown or not (self.starts or self.initial is not None):
             raise ValueError(
@@ -215,7 +153,7 @@ class OE:
         no_cov = ""
         for j in range(data.n_outputs):
             cols = range(data.n_inputs) if mode == "miso" else [j]
-            prob = _Problem(
+            prob = SimulationError(
                 data.y[:, j],
                 np.hstack(
                     [
@@ -225,6 +163,8 @@ class OE:
                 ),
                 structure.na,
                 structure.max_lag,
+                self.segments,
+                self.full_run,
             )
             fits = {}
             for name, model in starts.items():
