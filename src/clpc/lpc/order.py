@@ -205,7 +205,8 @@ def _by_validation(
         rejected = [int(o) for o, ok in zip(table.orders, usable, strict=True) if not ok]
         reason = (
             f"order {table.orders[best_i]}: the lowest whose held-out score (mean of free-run "
-            f"and {k}-step fit %) is within {parsimony:g} points of the best stable one"
+            f"and {k}-step fit %) is within {parsimony:g} point{'' if parsimony == 1 else 's'} "
+            "of the best stable one"
             + (f"; unstable or diverging orders {rejected} were rejected" if rejected else "")
         )
     else:
