@@ -168,7 +168,7 @@ def test_a_slow_pole_zero_pair_is_not_fitted_to_one_start_transient():
         return np.array([fold_fits(model, later[o:], 10)[0][0] for o in (0, 20, 40, 60)])
 
     ls = free_runs(arx)
-    one = OE(order=4, segments=1, assess=False, uncertainty=False).fit(fit)
+    one = OE(order=4, segments=1, cancel=False, assess=False, uncertainty=False).fit(fit)
     assert np.min(free_runs(one) - ls) < -20.0  # the reason for the test (measured: -125.6)
     assert np.max(np.abs(one.poles(0))) > 0.99
     oe = OE(order=4, assess=False, uncertainty=False).fit(fit)
@@ -185,3 +185,45 @@ def test_initial_state_equals_scipy_lfiltic():
         past = rng.standard_normal((na, 3))
         want = np.column_stack([signal.lfiltic([1.0], a, col) for col in past.T])
         np.testing.assert_allclose(_initial_state(a, past), want, rtol=1e-14, atol=1e-14)
+
+
+def test_a_common_factor_of_an_order_too_high_is_cancelled():
+    # order 3 on a noise-free order-2 record: any common factor fits exactly; it is removed
+    # and the order-2 fit is written in the order-3 structure (a pole and a zero at z = 0)
+    u, y, _ = _record(2)
+    model = OE(order=3, assess=False, uncertainty=False).fit(u, y)
+    assert model.info["cancelled"] == 1
+    np.testing.assert_allclose(model.den, np.r_[A, 0.0], atol=1e-8)
+    np.testing.assert_allclose(model.num, np.r_[B, 0.0], atol=1e-8)
+    kept = OE(order=3, cancel=False, assess=False, uncertainty=False).fit(u, y)
+    assert kept.info["cancelled"] == 0
+    np.testing.assert_allclose(kept.simulate(u), model.simulate(u), atol=1e-8)
+
+
+def test_a_close_pair_that_carries_the_gain_is_kept():
+    # a pole at 0.97 and a zero at 0.985 (0.015 apart, inside CANCEL_DISTANCE) halve the DC
+    # gain: the order-1 refit loses far more than KEEP_FIT_POINTS, so the pair stays
+    a = np.real(np.poly([0.97, 0.5]))
+    b = np.r_[0.0, np.real(np.poly([0.985]))]
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(1000)
+    y0 = signal.lfilter(b, a, u)
+    y = y0 + 0.05 * y0.std() * rng.standard_normal(1000)
+    model = OE(order=2, assess=False, uncertainty=False).fit(u, y)
+    assert model.info["cancelled"] == 0
+    np.testing.assert_allclose(np.sort(np.roots(model.den)), [0.5, 0.97], atol=0.01)
+
+
+def test_the_cancelled_coefficients_have_no_variance_and_the_others_keep_theirs():
+    # order 3 on an order-2 record with little output noise (std 0.01): the extra pair is
+    # cancelled here (with this seed; at other noise draws the extra pair may sit apart)
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(1000)
+    y = signal.lfilter(B, A, u) + 0.01 * rng.standard_normal(1000)
+    model = OE(order=3, assess=False).fit(u, y)
+    assert model.info["cancelled"] == 1
+    lo, hi = model.confidence_interval(0.95)
+    width = hi - lo  # a1 a2 a3 | b0 b1 b2 b3: a3 and b3 are the padding
+    assert width[2] == 0.0 and width[6] == 0.0
+    assert np.all(width[[0, 1, 3, 4, 5]] > 0.0)
+    np.testing.assert_allclose((lo + hi) / 2, np.r_[model.den[1:], model.num], atol=1e-12)
