@@ -270,6 +270,24 @@ def test_mutated_model_files_are_refused_or_load_valid(model_doc, tmp_path_facto
         np.testing.assert_allclose(theta, np.atleast_2d(model.theta), rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("nk", [10**9, 2**63])
+@pytest.mark.parametrize("keep_num", [True, False])
+def test_a_huge_delay_in_a_model_file_is_refused_before_anything_is_allocated(
+    model_doc, tmp_path, nk, keep_num
+):
+    # found by the fuzz test above: nk is not tied to theta's length; nk = 1e9 made the
+    # transfer-function check allocate 8 GB (minutes), nk = 2**63 raised numpy's ValueError
+    _, doc = model_doc
+    edited = copy.deepcopy(doc)
+    edited["structure"]["nk"] = nk
+    if not keep_num:
+        del edited["num"], edited["den"]
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(edited))
+    with pytest.raises(ModelFileError, match=r"structure\.nk = "):
+        load_model(path)
+
+
 @pytest.mark.parametrize(
     ("text_of", "match"),
     [

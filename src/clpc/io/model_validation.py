@@ -21,6 +21,10 @@ __all__ = ["model_from_dict"]
 _MODES = ("siso", "paired", "miso")
 #: largest parameter magnitude read: norms and products of larger values overflow
 _MAX_VALUE = 1e150
+#: most numerator coefficients (outputs x inputs x (nk + nb + 1)) a model file may imply:
+#: the delay ``nk`` is not tied to the length of ``theta``, and an edited ``nk = 10**9``
+#: would otherwise allocate gigabytes when the transfer functions are formed
+_MAX_NUM_COEFFICIENTS = 10_000_000
 
 
 def _fail(where: str, msg: str) -> ModelFileError:
@@ -183,6 +187,15 @@ def model_from_dict(d: dict[str, Any], *, source: str | None = None) -> LinearMo
     if mode not in _MODES:
         raise _fail(where, f"mode must be 'siso', 'paired' or 'miso'; got {mode!r}.")
     n_inputs, n_outputs = _channels(d, mode, where)
+    width = structure.nk + structure.nb + 1
+    if n_outputs * n_inputs * width > _MAX_NUM_COEFFICIENTS:
+        raise _fail(
+            where,
+            f"structure.nk = {structure.nk} with nb = {structure.nb} implies {width} numerator "
+            f"coefficients per input and output (more than {_MAX_NUM_COEFFICIENTS:.0e} in "
+            "all); no record is long enough to fit or use such a delay (the file was edited "
+            "or damaged).",
+        )
     p = structure.n_params(n_inputs if mode == "miso" else 1)
     theta = _array_field(d["theta"], "theta", (n_outputs, p), where)
     c = _array_field(_get(d, "c", where), "c", (n_outputs,), where)
