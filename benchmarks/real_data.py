@@ -60,6 +60,8 @@ W = ("sim", "k10")
 NEW = ("LPC new", "LPC paper", "LPC std", "ARX", "OE", "auto")
 #: the estimators ``auto`` chooses from (``clpc.identify``)
 BASE = ("LPC new", "ARX", "OE")
+#: identify's name of each of them (its table's ``estimator``)
+IDENTIFY_NAMES = {"LPC new": "lpc", "ARX": "arx", "OE": "oe"}
 #: ``auto`` must be within this many points of the best of BASE (free run)
 AUTO_POINTS = 1.0
 BEFORE = "LPC before"
@@ -201,16 +203,44 @@ def median(vals: list[float]) -> str:
 
 
 # ====================================================================== auto
+def evidence(chosen: clpc.Identification, j: int) -> dict:
+    """Output ``j``'s choice and each candidate's held-out free runs at identify's origins."""
+    out = chosen.model.output_names[j]
+    return {
+        "chosen": chosen.estimators[j],
+        "origins": {r["estimator"]: list(r["windows"]) for r in chosen.table if r["output"] == out},
+    }
+
+
+def miss_evidence(r: dict) -> str:
+    """Why ``auto`` missed row ``r``: the origins of its choice and of the validation winner."""
+    if "identify" not in r:
+        return ""
+    winner = max(BASE, key=lambda m: r[m]["sim"])
+    picked, origins = r["identify"]["chosen"], r["identify"]["origins"]
+
+    def runs(name: str) -> str:
+        w = origins.get(name, [])
+        return ", ".join(f"{v:.1f}" for v in w) + (f" (mean {np.mean(w):.1f})" if w else "")
+
+    return (
+        f"  {r['label']} N={r['N']}: chose {picked.upper()}, held out at the origins "
+        f"{runs(picked)}, validation {r['auto']['sim']:.1f}; {winner} "
+        f"{runs(IDENTIFY_NAMES[winner])}, validation {r[winner]['sim']:.1f}"
+    )
+
+
 def auto_report(rows: list[dict], picks: dict[str, int]) -> None:
     """How ``auto`` (``clpc.identify``) does against the best of LPC new, ARX and OE."""
     n = len(rows)
-    gaps, misses, bad = [], [], 0
+    gaps, misses, why, bad = [], [], [], 0
     for r in rows:
         top = max(r[m]["sim"] for m in BASE)
         gap = top - r["auto"]["sim"] if np.isfinite(top) else 0.0
         gaps.append(gap)
         if gap > AUTO_POINTS:
             misses.append(f"{r['label']} N={r['N']} ({gap:.1f})")
+            why.append(miss_evidence(r))
         stable_exists = any(r[m]["status"] != "unstable" for m in BASE)
         bad += stable_exists and r["auto"]["status"] == "unstable"
     finite = [g for g in gaps if np.isfinite(g)]
@@ -219,6 +249,13 @@ def auto_report(rows: list[dict], picks: dict[str, int]) -> None:
         f"{n - len(misses)}/{n} rows, largest shortfall {max(finite):.1f} points"
         + (f"; more than {AUTO_POINTS:g} point behind in: {'; '.join(misses)}" if misses else "")
     )
+    if why:
+        print(
+            "each miss: identify's held-out free runs (fitted before 1/2, 2/3 and 0.8 of the "
+            "estimation part, scored on the rest of it) of its choice and of the validation "
+            "winner:"
+        )
+        print("\n".join(line for line in why if line))
     print(f"auto unstable although a stable candidate existed: {bad}/{n} rows")
     print(f"auto chose: {', '.join(f'{k} {v}' for k, v in sorted(picks.items()))}")
 
@@ -256,6 +293,7 @@ def main(argv: list[str] | None = None) -> int:
                     models[label] = est.fit(ue, ye)
                 except (clpc.ModelError, clpc.DataError) as exc:
                     models[label] = f"{type(exc).__name__}: {exc}"
+            chosen = None
             try:
                 chosen = clpc.identify(ue, ye, order=order, nk=0, mimo=mode)
                 models["auto"] = chosen.model
@@ -272,6 +310,7 @@ def main(argv: list[str] | None = None) -> int:
                 rows.append(
                     {"label": label, "N": order, "cancel": cancelled}
                     | {m: scores[m][j] for m in methods}
+                    | ({"identify": evidence(chosen, j)} if chosen is not None else {})
                 )
 
     n = len(rows)
