@@ -312,12 +312,17 @@ def _objective_fit(prob: SimulationError, x: np.ndarray) -> float:
     return float(100.0 * (1.0 - np.linalg.norm(prob.residual(x)) / np.linalg.norm(t - t.mean())))
 
 
+def _rho(den: np.ndarray) -> np.ndarray:
+    """The search's ``rho`` of a stable monic ``den`` (its reflection coefficients, clipped)."""
+    kappa = np.clip(reflection_from_poly(den), -MAX_KAPPA * (1 - 1e-12), MAX_KAPPA * (1 - 1e-12))
+    return np.arctanh(kappa / MAX_KAPPA)
+
+
 def _start_vector(model: LinearModel, j: int, cols: list[int], structure: Structure) -> np.ndarray:
     """``[rho; b; k]`` of output ``j`` of a start model (made stable first)."""
     den = model.denominators[j]
-    kappa = np.clip(reflection_from_poly(den), -MAX_KAPPA * (1 - 1e-12), MAX_KAPPA * (1 - 1e-12))
     b = np.concatenate([model.numerators[j, i, structure.nk :] for i in cols])
-    x0 = np.concatenate([np.arctanh(kappa / MAX_KAPPA), b, [model.intercept[j]]])
+    x0 = np.concatenate([_rho(den), b, [model.intercept[j]]])
     if not np.all(np.isfinite(x0)):
         raise ModelError(f"the start model of output {j} has non-finite parameters.")
     return x0
@@ -354,8 +359,7 @@ def _cancelled(
         prob.segments,
         prob.full_run,
     )
-    kappa = np.clip(reflection_from_poly(den), -MAX_KAPPA * (1 - 1e-12), MAX_KAPPA * (1 - 1e-12))
-    x0 = np.concatenate([np.arctanh(kappa / MAX_KAPPA), red[:, nk:].ravel(), [0.0]])
+    x0 = np.concatenate([_rho(den), red[:, nk:].ravel(), [0.0]])
     res = _search(small, x0, max_nfev)
     if not np.isfinite(res.cost):
         return None
