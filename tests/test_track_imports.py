@@ -27,6 +27,15 @@ def _modules_after(code: str) -> set[str]:
     return set(res.stdout.split())
 
 
+def _record_csv(path, n: int, seed: int):
+    """A ``u,y`` CSV of ``n`` samples of a small FIR system with a little output noise."""
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.convolve(u, [0.0, 0.5, 0.2])[:n] + 0.01 * rng.standard_normal(n)
+    np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
+    return path
+
+
 def test_the_track_command_imports_neither_scipy_signal_nor_matplotlib():
     loaded = _modules_after("import clpc.cli.track, clpc.workflows.track, clpc.appraiser")
     assert not loaded & {"scipy.signal", "scipy.optimize", "matplotlib"}, loaded
@@ -35,11 +44,7 @@ def test_the_track_command_imports_neither_scipy_signal_nor_matplotlib():
 def test_the_fast_reader_and_trace_writer_do_not_import_pandas(tmp_path):
     pytest.importorskip("pyarrow")
     pytest.importorskip("pandas")  # the point: pyarrow's to_numpy / pa.array would load it
-    rng = np.random.default_rng(3)
-    u = rng.standard_normal(600)
-    y = np.convolve(u, [0.0, 0.5, 0.2])[:600] + 0.01 * rng.standard_normal(600)
-    path = tmp_path / "rec.csv"
-    np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
+    path = _record_csv(tmp_path / "rec.csv", 600, seed=3)
     out = tmp_path / "trace.csv"
     loaded = _modules_after(
         f"""
@@ -59,11 +64,7 @@ def test_the_fast_reader_and_trace_writer_do_not_import_pandas(tmp_path):
 def test_the_whole_track_run_with_its_report_needs_neither_scipy_signal_nor_stats(tmp_path):
     """Simulation, prediction, the Bode plot and the residual tests of the report use
     clpc.core.filters and scipy.special (0.6-0.8 s of imports fewer)."""
-    rng = np.random.default_rng(5)
-    u = rng.standard_normal(4000)
-    y = np.convolve(u, [0.0, 0.5, 0.2])[:4000] + 0.01 * rng.standard_normal(4000)
-    path = tmp_path / "rec.csv"
-    np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
+    path = _record_csv(tmp_path / "rec.csv", 4000, seed=5)
     out = tmp_path / "out"
     loaded = _modules_after(
         f"""

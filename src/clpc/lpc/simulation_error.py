@@ -122,6 +122,7 @@ class SimulationError:
     full_run: bool = True
     starts: np.ndarray = field(init=False)
     _blocks: tuple[_Block, ...] = field(init=False, repr=False)
+    _times: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         m = self.y.size - self.s
@@ -135,6 +136,7 @@ class SimulationError:
             )
         else:
             self._blocks = (_Block.of(self.starts, lengths, self.s),)
+        self._times = np.concatenate([blk.rows(blk.pos) for blk in self._blocks])
 
     def _past(self, starts: np.ndarray) -> np.ndarray:
         """Measured outputs before each run, shape (na, R): ``y(start-1), y(start-2)``..."""
@@ -164,11 +166,11 @@ class SimulationError:
 
     def targets(self) -> np.ndarray:
         """The measured ``y(n)`` of every row of the residual."""
-        return np.concatenate([self.y[self.s :][blk.rows(blk.pos)] for blk in self._blocks])
+        return self.y[self.s :][self._times]
 
     def times(self) -> np.ndarray:
         """The sample ``n - s`` of every row of the residual."""
-        return np.concatenate([blk.rows(blk.pos) for blk in self._blocks])
+        return self._times
 
     def residual(self, x: np.ndarray) -> np.ndarray:
         """Simulation errors ``y(n) - y_hat(n)`` of every run, the runs one after the other."""
