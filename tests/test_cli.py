@@ -69,7 +69,7 @@ def test_datasets_lists_paths():
     out = ok("datasets").output
     for name in ("robot_arm", "dryer", "ballbeam", "cd_player_arm", "cascaded_tanks"):
         assert name in out
-    rows = json.loads(ok("datasets", "--json").output)["datasets"]
+    rows = json.loads(ok("datasets", "--json").stdout)["datasets"]
     assert all(os.path.exists(r["path"]) for r in rows)
     tanks = next(r for r in rows if r["name"] == "cascaded_tanks")
     assert tanks["validation_inputs"] == ["uVal"]
@@ -93,7 +93,7 @@ def test_identify_text_on_shipped_record():
 
 def test_identify_json_matches_library():
     res = ok("identify", DRYER, "-u", "u", "-y", "y", "--order", "3", "--json", "--dt", "0.08")
-    s = json.loads(res.output)
+    s = json.loads(res.stdout)
     data = ds.load("dryer")
     model = clpc.LPC(order=3).fit(data)
     eq = s["equations"][0]
@@ -157,7 +157,7 @@ def test_identify_mimo_and_column_indices():
     )
     assert [e["output"] for e in s["equations"]] == ["y1", "y2"]
     assert set(s["equations"][0]["num"]) == {"u1", "u2"}
-    by_index = json.loads(ok("identify", DRYER, "-u", "0", "-y", "1", "--json").output)
+    by_index = json.loads(ok("identify", DRYER, "-u", "0", "-y", "1", "--json").stdout)
     assert by_index["inputs"] == ["u"] and by_index["outputs"] == ["y"]
 
 
@@ -179,7 +179,7 @@ def test_save_simulate_compare_round_trip(record, tmp_path):
     assert lines[0] == "u,y_sim" and len(lines) == len(u) + 1
     assert float(lines[-1].split(",")[1]) == pytest.approx(table["y_sim"][-1])
     # compare: free run and k-step, text, JSON and plot
-    res = json.loads(ok("compare", model_file, path, "--json").output)
+    res = json.loads(ok("compare", model_file, path, "--json").stdout)
     _, _, fit = model_response(model, u, y)
     assert res["fit"]["y"] == pytest.approx(fit[0]) and res["compared"] == "simulation"
     res = json.loads(

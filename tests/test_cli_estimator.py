@@ -37,7 +37,7 @@ def test_estimator_auto_prints_the_table_and_the_reason():
 def test_nk_auto_json_matches_the_library():
     res = run("identify", DRYER, "-u", "u", "-y", "y", "--nk", "auto", "--json")
     assert res.exit_code == 0, res.output
-    summary = json.loads(res.output)
+    summary = json.loads(res.stdout)
     lib = clpc.identify(ds.load("dryer"), estimator="lpc", nk="auto")
     comp = summary["comparison"]
     assert comp["nk"] == lib.nk and comp["estimators"] == ["lpc"]
@@ -67,7 +67,7 @@ def test_order_auto_with_an_estimator_lists_every_order():
     args = ("--estimator", "arx", "--order", "auto", "--max-order", "3", "--json")
     res = run("identify", DRYER, "-u", "u", "-y", "y", *args)
     assert res.exit_code == 0, res.output
-    comp = json.loads(res.output)["comparison"]
+    comp = json.loads(res.stdout)["comparison"]
     assert sorted({r["order"] for r in comp["table"]}) == [1, 2, 3]
     assert comp["estimators"] == ["arx"]
     lib = clpc.identify(ds.load("dryer"), estimator="arx", order="auto", max_order=3)

@@ -127,7 +127,7 @@ def test_metadata_line_and_units_row(tmp_path):
         ],
     )
     assert res.exit_code == 0, res.output
-    summary = json.loads(res.output)
+    summary = json.loads(res.stdout)
     assert summary["n_samples"] == 50
     assert summary["dt"] == pytest.approx(0.01)
 

@@ -26,7 +26,7 @@ def test_multimodel_command_saves_a_model_that_simulates_the_same(tmp_path):
     args = ["multimodel", str(data), "-u", "command", "-y", "position", "--dt", "0.01"]
     res = CliRunner().invoke(cli, [*args, "--save", str(model), "--figure", str(fig), "--json"])
     assert res.exit_code == 0, res.output
-    out = json.loads(res.output)
+    out = json.loads(res.stdout)
     assert out["n_models"] >= 3 and out["centre_source"] == "windows"
     fits = out["fit_on_record"]
     assert fits["multimodel"]["free_run"] > fits["global_least_squares"]["free_run"] + 5
