@@ -124,7 +124,7 @@ def test_identify_auto_order(record):
             "--time",
             "t",
             "--json",
-        ).output
+        ).stdout
     )
     sel = clpc.select_order(
         clpc.io.load_iodata(path, "u", "y"), orders=range(1, 5), criterion="validation"
@@ -153,7 +153,7 @@ def test_identify_mimo_and_column_indices():
             "-y",
             "y2",
             "--json",
-        ).output
+        ).stdout
     )
     assert [e["output"] for e in s["equations"]] == ["y1", "y2"]
     assert set(s["equations"][0]["num"]) == {"u1", "u2"}
