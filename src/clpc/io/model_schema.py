@@ -110,7 +110,9 @@ def model_to_dict(model: LinearModel) -> dict[str, Any]:
     Returns
     -------
     dict
-        Plain Python values only (``json.dumps`` works on it directly, strict JSON).
+        Plain Python values only (``json.dumps`` works on it directly, strict JSON). The
+        evidence a fit offers on demand (held-out fit, residual tests, covariance) is
+        computed first (:meth:`LinearModel.assess`): a saved model carries it.
 
     Raises
     ------
@@ -119,6 +121,7 @@ def model_to_dict(model: LinearModel) -> dict[str, Any]:
     """
     from clpc._version import __version__
 
+    model.assess()
     s = model.structure
     dt = float(model.dt)
     if not (math.isfinite(dt) and dt > 0):

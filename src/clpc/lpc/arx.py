@@ -8,7 +8,7 @@ put side by side.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -101,9 +101,7 @@ class ARX:
             model = without_covariance(model, no_cov)
         elif self.uncertainty:
             model = with_covariance(model, np.stack(covs), np.array(dofs), "least squares")
-        if not self.assess:
-            return model
-        return assessment.assess(model, data, replace(self, assess=False, uncertainty=False).fit)
+        return assessment.with_record(model, data, self)
 
 
 def simulate_arx(den: Any, num: Any, u: Any, noise: Any | None = None) -> np.ndarray:

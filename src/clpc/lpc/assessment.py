@@ -24,9 +24,10 @@ import numpy as np
 from clpc.data import DataError, IOData
 from clpc.lpc import heldout
 from clpc.model import LinearModel, ModelError
+from clpc.model.evidence import FitRecord
 from clpc.model.residuals import residual_analysis
 
-__all__ = ["HELDOUT_FRACTION", "assess"]
+__all__ = ["HELDOUT_FRACTION", "assess", "evidence", "with_record"]
 
 #: Share of the record held out (the last part), as :func:`clpc.select_order` does.
 HELDOUT_FRACTION = 1.0 / 3.0
@@ -76,8 +77,10 @@ def residual_evidence(model: LinearModel, data: IOData) -> dict[str, Any]:
     }
 
 
-def assess(model: LinearModel, data: IOData, refit: Callable[[IOData], LinearModel]) -> LinearModel:
-    """``model`` with ``info["heldout"]`` and ``info["residual_test"]`` (see the module).
+def evidence(
+    model: LinearModel, data: IOData, refit: Callable[[IOData], LinearModel]
+) -> dict[str, Any]:
+    """``info["heldout"]`` and ``info["residual_test"]`` of ``model`` (see the module).
 
     Parameters
     ----------
@@ -86,9 +89,53 @@ def assess(model: LinearModel, data: IOData, refit: Callable[[IOData], LinearMod
     data : IOData
         The record.
     refit : callable
-        The same estimator (without assessment) on a part of the record.
+        The same estimator (without evidence) on a part of the record.
+
+    Returns
+    -------
+    dict
+        ``{"heldout": ..., "residual_test": ...}``.
     """
-    info = dict(model.info)
-    info["heldout"] = heldout_evidence(data, refit)
-    info["residual_test"] = residual_evidence(model, data)
-    return replace(model, info=info)
+    return {
+        "heldout": heldout_evidence(data, refit),
+        "residual_test": residual_evidence(model, data),
+    }
+
+
+def with_record(
+    model: LinearModel,
+    data: IOData,
+    estimator: Any,
+    covariance: Callable[[LinearModel], dict[str, Any]] | None = None,
+) -> LinearModel:
+    """The tail of every fit: ``model`` keeping its record and its evidence on demand.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The estimate.
+    data : IOData
+        The record it was fitted on.
+    estimator : LPC, ARX or OE
+        The estimator (a dataclass with ``assess`` and ``uncertainty`` flags): with
+        ``assess``, :func:`evidence` is offered, refitting a copy of it without evidence.
+    covariance : callable, optional
+        ``f(model) -> dict`` of covariance entries, offered when given.
+
+    Returns
+    -------
+    LinearModel
+        With a :class:`clpc.model.evidence.FitRecord`; nothing is computed yet.
+    """
+    record = FitRecord(data)
+    if covariance is not None:
+        record = record.with_producer("covariance", covariance)
+    if estimator.assess:
+        refit = replace(estimator, assess=False, uncertainty=False).fit
+        record = record.with_producer("assessment", lambda fitted: evidence(fitted, data, refit))
+    return replace(model, record=record)
+
+
+def assess(model: LinearModel, data: IOData, refit: Callable[[IOData], LinearModel]) -> LinearModel:
+    """``model`` with the entries of :func:`evidence` in its ``info`` (computed now)."""
+    return replace(model, info={**model.info, **evidence(model, data, refit)})

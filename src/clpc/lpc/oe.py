@@ -28,7 +28,7 @@ is not.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -249,9 +249,7 @@ class OE:
             cov = np.stack([c for c, _ in covs])
             dof = np.array([d for _, d in covs])
             model = with_covariance(model, cov, dof, "Jacobian of the simulation error")
-        if not self.assess:
-            return model
-        return assessment.assess(model, data, replace(self, assess=False, uncertainty=False).fit)
+        return assessment.with_record(model, data, self)
 
     def _starts(self, data: IOData, structure: Structure, mode: str) -> dict[str, LinearModel]:
         """The least-squares and LPC fits (and ``initial``) that start the search."""

@@ -147,9 +147,10 @@ def regressors(data: IOData, structure: Structure, mode: MimoMode) -> np.ndarray
     Returns
     -------
     ndarray, shape (n_equations, n_rows, n_params)
-        ``n_equations = n_outputs``; ``n_rows = T - max_lag``, summed over the experiments
-        of a record that holds several (each experiment gives its own rows: no lag vector
-        reaches across a boundary).
+        Each ``[j]`` column-major (Fortran order). ``n_equations = n_outputs``;
+        ``n_rows = T - max_lag``, summed over the experiments of a record that holds
+        several (each experiment gives its own rows: no lag vector reaches across a
+        boundary).
     """
     check_mode(mode, data.n_inputs, data.n_outputs)
     if data.n_experiments > 1:
@@ -158,11 +159,15 @@ def regressors(data: IOData, structure: Structure, mode: MimoMode) -> np.ndarray
         structure.max_lag + 2,
         f"A model with na={structure.na}, nb={structure.nb}, nk={structure.nk}",
     )
-    if mode == "miso":
-        mats = [miso_regressor(data.y[:, j], data.u, structure) for j in range(data.n_outputs)]
-    else:  # siso and paired: output j with input j
-        mats = [
-            miso_regressor(data.y[:, j], data.u[:, j : j + 1], structure)
-            for j in range(data.n_outputs)
-        ]
-    return np.stack(mats)
+    start, n_out, n_rows = structure.max_lag, data.n_outputs, data.n_samples - structure.max_lag
+    n_in = data.n_inputs if mode == "miso" else 1
+    na1, nb1 = structure.na + 1, structure.nb + 1
+    # each out[j] column-major (Fortran order): a column is one contiguous copy of a signal
+    out = np.empty((n_out, na1 + n_in * nb1, n_rows)).transpose(0, 2, 1)
+    for j in range(n_out):
+        columns = [(data.y[:, j], lag) for lag in range(na1)]
+        inputs = range(n_in) if mode == "miso" else (j,)  # siso and paired: input j
+        columns += [(data.u[:, i], structure.nk + lag) for i in inputs for lag in range(nb1)]
+        for col, (signal, lag) in enumerate(columns):
+            out[j, :, col] = signal[start - lag : start - lag + n_rows]  # x(n - lag)
+    return out

@@ -31,6 +31,7 @@ from clpc.model import LinearModel, Structure
 __all__ = [
     "JACKKNIFE_BLOCKS",
     "MIN_BLOCK_ROWS_PER_PARAMETER",
+    "covariance_entries",
     "covariance_from_jacobian",
     "least_squares_covariance",
     "lpc_jackknife",
@@ -68,22 +69,35 @@ def monic_map(structure: Structure, n_inputs: int, mode: str, output: int = 0) -
     return out
 
 
-def with_covariance(model: LinearModel, cov: np.ndarray, dof: Any, method: str) -> LinearModel:
-    """``model`` with ``info["covariance"]``, ``["covariance_dof"]``, ``["covariance_method"]``.
+def covariance_entries(
+    model: LinearModel, cov: np.ndarray, dof: Any, method: str
+) -> dict[str, Any]:
+    """The ``info`` entries of a covariance: ``covariance``, ``covariance_dof``, ``_method``.
 
     Parameters
     ----------
+    model : LinearModel
+        The model the covariance belongs to (for its shape).
     cov : ndarray, shape (n_outputs, q, q)
+        Covariance of ``np.r_[den[1:], num]`` per output.
     dof : float or ndarray, shape (n_outputs,)
+        Degrees of freedom of the variance estimate.
     method : str
         How the covariance was obtained (shown by :meth:`LinearModel.summary`).
     """
     q = model.n_inputs * (model.structure.nk + model.structure.nb + 1) + model.structure.na
     cov = np.asarray(cov, dtype=np.float64).reshape(model.n_outputs, q, q)
+    return {
+        "covariance": 0.5 * (cov + np.swapaxes(cov, 1, 2)),
+        "covariance_dof": np.broadcast_to(np.asarray(dof, float), (model.n_outputs,)).copy(),
+        "covariance_method": method,
+    }
+
+
+def with_covariance(model: LinearModel, cov: np.ndarray, dof: Any, method: str) -> LinearModel:
+    """``model`` with the entries of :func:`covariance_entries` in its ``info``."""
     info = {k: v for k, v in model.info.items() if k != "covariance_note"}
-    info["covariance"] = 0.5 * (cov + np.swapaxes(cov, 1, 2))
-    info["covariance_dof"] = np.broadcast_to(np.asarray(dof, float), (model.n_outputs,)).copy()
-    info["covariance_method"] = method
+    info.update(covariance_entries(model, cov, dof, method))
     return replace(model, info=info)
 
 

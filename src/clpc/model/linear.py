@@ -33,6 +33,7 @@ from clpc.core.polynomials import monic, pole_class
 from clpc.model import display, simulation
 from clpc.model import uncertainty as _unc
 from clpc.model.errors import ModelError
+from clpc.model.evidence import FitInfo, FitRecord
 from clpc.model.structure import Structure
 
 __all__ = ["LinearModel", "ModelError"]
@@ -62,6 +63,11 @@ class LinearModel:
         Channel names.
     info : dict
         Fit statistics (eigenvalues, D, noise variance, J, verdict...) per output.
+    record : FitRecord, optional
+        The record the model was fitted on and how to compute its evidence (held-out fit,
+        residual tests, jackknife covariance) on demand: then ``info`` is a
+        :class:`clpc.model.evidence.FitInfo` that computes those entries when first read
+        (:meth:`assess` computes them all). ``None`` for hand-built and loaded models.
     """
 
     theta: np.ndarray
@@ -73,14 +79,42 @@ class LinearModel:
     input_names: tuple[str, ...] = ("u",)
     output_names: tuple[str, ...] = ("y",)
     info: dict[str, Any] = field(default_factory=dict)
+    record: FitRecord | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         theta = np.atleast_2d(np.asarray(self.theta, dtype=np.float64))
         object.__setattr__(self, "_theta2", theta)
         object.__setattr__(self, "theta", theta[0] if theta.shape[0] == 1 else theta)
         object.__setattr__(self, "c", np.atleast_1d(np.asarray(self.c, dtype=np.float64)))
+        given = self.info
         if theta.shape[0] == 1:
-            object.__setattr__(self, "info", display.squeeze_info(self.info))
+            object.__setattr__(self, "info", display.squeeze_info(given))
+        if self.record is not None:
+            object.__setattr__(self, "info", FitInfo(self.info, self, self.record, given))
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle without the record: the entries computed so far, nothing pending.
+
+        A pickled model does not carry its record (which would send the data along, e.g.
+        to or from a Dask worker); call :meth:`assess` first to keep all the evidence.
+        """
+        state = dict(self.__dict__)
+        state["record"] = None
+        state["info"] = dict(self.info)
+        return state
+
+    def assess(self) -> LinearModel:
+        """Compute every piece of evidence still pending (see :mod:`clpc.model.evidence`).
+
+        Returns
+        -------
+        LinearModel
+            ``self``, whose ``info`` then holds ``heldout``, ``residual_test`` and the
+            covariance entries its estimator provides.
+        """
+        if isinstance(self.info, FitInfo):
+            self.info.compute_all()
+        return self
 
     @property
     def theta_matrix(self) -> np.ndarray:

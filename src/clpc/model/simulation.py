@@ -112,30 +112,80 @@ def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
         )
     start = model.structure.max_lag
     x = forced(model, u2, None) + model.intercept[None, :]
-    dens = model.denominators
-    na = model.structure.na
     n = y2.shape[0]
-    preds = [y2]  # preds[j]: prediction of y(n) from outputs measured up to n - j
-    for step in range(1, k + 1):
-        acc = x[start:].copy()
-        for lag in range(1, na + 1):
-            src = preds[max(step - lag, 0)]
-            acc -= dens[:, lag][None, :] * src[start - lag : n - lag]
-        cur = y2.copy()
-        cur[start:] = acc
-        preds.append(cur)
-    out = preds[k]
+    out = y2.copy()
     oe = [j for j, v in enumerate(noise_models(model)) if v == "output-error"]
+    for j in range(model.n_outputs):
+        if j not in oe:
+            out[start:, j] = _kstep(model.denominators[j], x[:, j], y2[:, j], start, k)
     if oe:
-        out = out.copy()
         sim = simulate(
             model,
             u2[start:],
-            y_init=y2[:start] if na else None,
+            y_init=y2[:start] if model.structure.na else None,
             u_init=u2[:start] if start else None,
         )
         out[start:, oe] = np.asarray(sim).reshape(n - start, model.n_outputs)[:, oe]
     return out[:, 0] if (y_1d and model.n_outputs == 1) else out
+
+
+def _kstep(den: np.ndarray, x: np.ndarray, y: np.ndarray, start: int, k: int) -> np.ndarray:
+    """``y_hat(n | n-k)`` of one equation ``A(q) y = x + e`` for ``n >= start``, O(T) memory.
+
+    With ``F_k`` the first ``k`` terms of ``1/A`` (so ``F_k A = 1 - q^-k G_k``), the
+    ``k``-step predictor is the pair of filters ``y_hat = F_k x + (1 - F_k A) y``: it removes
+    the ``k`` latest equation errors ``e(n) .. e(n-k+1)`` from ``y(n)``; ``1 - F_k A`` holds
+    only the lags ``k .. k+na-1``, so it reads outputs measured up to ``n - k``. For
+    ``n < start + k - 1`` fewer than ``k`` samples follow the first ``start`` measured ones:
+    there the prediction is the free run from them (as the step-by-step recursion gives).
+
+    Parameters
+    ----------
+    den : ndarray, shape (na + 1,)
+        Monic ``A``.
+    x : ndarray, shape (T,)
+        Forced part ``B u + intercept``.
+    y : ndarray, shape (T,)
+        Measured output.
+    start : int
+        First predicted sample (``max_lag``).
+    k : int
+        Horizon [samples], ``k >= 1``.
+
+    Returns
+    -------
+    ndarray, shape (T - start,)
+    """
+    na, n = den.size - 1, y.size
+    impulse = np.zeros(min(k, n))
+    impulse[0] = 1.0
+    f_k = all_pole(den, impulse)  # F_k, the first k terms of 1/A
+    tail = -np.convolve(f_k, den)  # 1 - F_k A: zero at lags 0 .. k-1
+    tail[0] += 1.0
+    out = np.empty(n - start)
+    head = min(k - 1, n - start)  # the free run from the measured start
+    past = y[start - na : start][::-1] if na else None
+    out[:head] = all_pole(den, x[start : start + head], past)
+    if head < n - start:
+        full = _convolve_head(x, f_k, n) + _convolve_head(y, tail[:n], n)
+        out[head:] = full[start + head :]
+    return out
+
+
+#: Below this many taps a direct convolution is cheaper than one by FFT.
+DIRECT_TAPS = 64
+
+
+def _convolve_head(x: np.ndarray, taps: np.ndarray, n: int) -> np.ndarray:
+    """The first ``n`` samples of ``np.convolve(x, taps)``: direct, or by FFT (O(n) memory).
+
+    The FFT length is the power of two that holds the whole convolution, so there is no
+    wrap-around; its rounding is about ``1e-16 * log2(length) * max|x| * sum|taps|``.
+    """
+    if taps.size <= DIRECT_TAPS:
+        return np.convolve(x, taps)[:n]
+    size = 1 << (x.size + taps.size - 2).bit_length()
+    return np.fft.irfft(np.fft.rfft(x, size) * np.fft.rfft(taps, size), size)[:n]
 
 
 def infer_input(
