@@ -29,7 +29,7 @@ from scipy import stats
 import clpc
 from clpc import datasets
 from clpc.analysis.operating_point import operating_point_diagnostics, window_means
-from clpc.plants.crank_servo import CrankParameters, crank_commands, simulate_crank_servo
+from clpc_paper.plants.crank_servo import CrankParameters, crank_commands, simulate_crank_servo
 
 START = 203
 

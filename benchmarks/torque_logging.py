@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from clpc.appraiser.decimation import decimate
-from clpc.experiment.analysis import linear_bound
-from clpc.experiment.settings import RAMP, RAMP_DURATION
-from clpc.plants import ServoParameters, ramp_with_saturation, simulate_servo
+from clpc_paper.experiment.analysis import linear_bound
+from clpc_paper.experiment.settings import RAMP, RAMP_DURATION
+from clpc_paper.plants import ServoParameters, ramp_with_saturation, simulate_servo
 
 
 def main() -> None:

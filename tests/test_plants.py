@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from clpc.plants import (
+from clpc_paper.plants import (
     ServoParameters,
     chirp,
     multisine,

@@ -137,10 +137,10 @@ def run_demo(
         :mod:`clpc.experiment` is not available.
     """
     try:
-        from clpc.experiment.run import run_experiment
+        from clpc_paper.experiment.run import run_experiment
     except ImportError as exc:
         raise ImportError(
-            f"the demo needs clpc.experiment, which is not available here ({exc})."
+            f"the demo needs clpc_paper.experiment, which is not available here ({exc})."
         ) from None
     summary = run_experiment(out_dir, duration=duration, quick=quick, seed=seed, method=method)
     written = sorted(p.name for p in Path(out_dir).iterdir() if p.is_file())
