@@ -487,10 +487,10 @@ def test_usage_errors_exit_2(record, tmp_path):
 
 # ================================================================= demo
 def test_demo_reports_missing_experiment(monkeypatch, tmp_path):
-    for name in ("clpc_paper.experiment", "clpc_paper.experiment.run"):
+    for name in ("clpc_paper", "clpc_paper.demo"):
         monkeypatch.setitem(sys.modules, name, None)  # import now fails
     r = fails(1, "demo", "--out", tmp_path)
-    assert "needs clpc_paper.experiment" in r.output
+    assert "needs clpc_paper" in r.output
 
 
 def test_demo_quick(tmp_path):

@@ -11,8 +11,8 @@ from clpc.analysis.metrics import fit_percent
 from clpc.core.jsonable import jsonable
 from clpc.lpc import ARX
 from clpc.multimodel import MultiModel
+from clpc.plotting.multimodel import plot_multimodel
 from clpc.workflows.common import RecordSpec
-from clpc_paper.experiment.nonlinear_figures import plot_multimodel
 
 __all__ = ["MultiModelSettings", "multimodel_file"]
 

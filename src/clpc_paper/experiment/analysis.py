@@ -11,10 +11,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from clpc.analysis.metrics import fit_percent
-from clpc.appraiser.trace import Trace
-from clpc.core.polynomials import monic_many
-from clpc.model import LinearModel
+from clpc import LinearModel, Trace, fit_percent
 from clpc_paper.experiment.settings import A0_MIN, RAMP
 
 __all__ = [
@@ -219,8 +216,9 @@ def online_prediction(trace: Trace, u: np.ndarray, y: np.ndarray, k: int) -> dic
     theta = trace.arrays["theta"][held]  # (N, 1, p)
     ok = (last >= 0) & (theta[:, 0, 0] >= A0_MIN)
     theta[~ok, 0, 0] = 1.0  # no usable model: any nonzero a0 (these samples are left out)
-    den, num = monic_many(theta, na, s.nb, s.nk, 1, False)
-    a, b = den[:, 0, 1:], num[:, 0, 0]  # y(m) = kk - sum a_i y(m-i) + sum b_j u(m-j)
+    # the trace's monic den/num of the held theta; y(m) = kk - sum a_i y(m-i) + sum b_j u(m-j)
+    a, b = trace.arrays["den"][held, 0, 1:], trace.arrays["num"][held, 0, 0]
+    a[~ok], b[~ok] = 0.0, 0.0  # the samples left out predict kk (finite, no warnings)
     kk = trace.c[held] / theta[:, 0, 0]
     past = [y[n - k - i] for i in range(na)]  # past[i] = y(m - 1 - i) for m = n - k + 1
     for step in range(1, k + 1):

@@ -1,7 +1,7 @@
 """The numeric criterion behind each of the paper's claims, one function per claim.
 
 Each ``check_*`` reads one command's part of the JSON-safe summary and returns the verdict
-dict of :data:`clpc.experiment.claims.Check`: what was measured, the criterion, why that
+dict of :data:`clpc_paper.experiment.claims.Check`: what was measured, the criterion, why that
 threshold and, when the claim is not reproduced, why (one sentence from the measurements).
 The thresholds are the module constants.
 """

@@ -3,7 +3,7 @@
 :func:`claims` turns the experiment's summary into a verdict per paper claim and per command
 (``"reproduced"``, ``"partly"``, ``"not reproduced"``) with the numbers behind it, the
 criterion, why that threshold and, when not reproduced, why
-(:mod:`clpc.experiment.claim_checks`). It reads only the JSON-safe summary, so a saved
+(:mod:`clpc_paper.experiment.claim_checks`). It reads only the JSON-safe summary, so a saved
 ``summary.json`` can be judged again.
 """
 

@@ -12,11 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from clpc.analysis.metrics import kstep_fit
-from clpc.appraiser.decimation import decimate
-from clpc.lpc.arx import ARX
-from clpc.lpc.estimator import LPC
-from clpc.model import LinearModel, ModelError
+from clpc import ARX, LPC, LinearModel, ModelError, kstep_fit
+from clpc.appraiser import decimate
 from clpc_paper.experiment.analysis import (
     constant_windows,
     error_profile,

@@ -1,10 +1,10 @@
 """The paper's Figs. 5-17 (and one comparison figure) from an experiment run, as PNG files.
 
 Figs. 5-12 (per cluster) are drawn here, Figs. 13-17 and the rich-command figure in
-:mod:`clpc.experiment.figures_signals`. Every figure carries the paper's number in its
+:mod:`clpc_paper.experiment.figures_signals`. Every figure carries the paper's number in its
 title and units on its axes, and says what its marks are: clusters without an estimate are
 gaps, windows at rest and untrusted windows are shaded and named, the convergence marker
-and steady-state line are :func:`clpc.experiment.marks.parameter_marks` (the report's rule).
+and steady-state line are :func:`clpc_paper.experiment.marks.parameter_marks` (the report's rule).
 """
 
 from __future__ import annotations
@@ -200,7 +200,7 @@ def write_figures(
     out_dir : Path
         Existing output folder.
     ramp, rich : CommandResult
-        Results of :func:`clpc.experiment.evaluation.analyse_command`.
+        Results of :func:`clpc_paper.experiment.evaluation.analyse_command`.
     smooth : TorqueCheck
         The ramp's torque estimate on the servo without Coulomb friction (Figs. 13-14 (b)).
     quick : bool

@@ -1,11 +1,11 @@
 """The experiment's report as an HTML page (``report.html``), from the same text as ``report.md``.
 
-:func:`render_html_report` renders the Markdown of :func:`clpc.experiment.report.render_report`
-(one source, so the two cannot drift) with :mod:`clpc.report.markdown` into the sections of
-:func:`clpc.report.write_html_report`: the verdicts first, with the claims not (or only partly)
-reproduced marked in the table and listed with their reasons in a warnings box under it; each
-figure beside its claim; the settings last and folded. Figures are linked relative to the
-page (they sit beside it).
+:func:`render_html_report` renders the Markdown of
+:func:`clpc_paper.experiment.report.render_report` (one source, so the two cannot drift) with
+:mod:`.markdown_html` into the sections of :func:`clpc.report.write_html_report`: the verdicts
+first, with the claims not (or only partly) reproduced marked in the table and listed with
+their reasons in a warnings box under it; each figure beside its claim; the settings last and
+folded. Figures are linked relative to the page (they sit beside it).
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from clpc.report.html import Section, warnings_html, write_html_report
-from clpc.report.markdown import markdown_to_html, split_sections
+from clpc.report import Section, warnings_html, write_html_report
 from clpc_paper.experiment.claims import NOT_REPRODUCED, PARTLY, REPRODUCED
+from clpc_paper.experiment.markdown_html import markdown_to_html, split_sections
 from clpc_paper.experiment.report import render_report
 
 __all__ = ["claim_warnings", "render_html_report", "verdict_class"]
@@ -54,7 +54,7 @@ def render_html_report(summary: dict[str, Any], path: str | Path) -> Path:
     Parameters
     ----------
     summary : dict
-        The JSON-safe summary of :func:`clpc.experiment.run_experiment`.
+        The JSON-safe summary of :func:`clpc_paper.experiment.run_experiment`.
     path : str or Path
         The HTML file; the figures named in the summary must sit in its folder.
 

@@ -6,9 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser.decimation import decimate
-from clpc.appraiser.facade import CLPC
-from clpc.appraiser.trace import Convergence, Trace
+from clpc import CLPC, Convergence, Trace
+from clpc.appraiser import decimate
 from clpc_paper.experiment.results import Identification
 from clpc_paper.experiment.settings import (
     CLUSTER_SIZE,

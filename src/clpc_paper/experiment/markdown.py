@@ -1,6 +1,6 @@
 """Markdown building blocks of the experiment report: figures, claims, tables.
 
-Each function reads the JSON-safe summary of :func:`clpc.experiment.run_experiment` and
+Each function reads the JSON-safe summary of :func:`clpc_paper.experiment.run_experiment` and
 returns Markdown text.
 """
 

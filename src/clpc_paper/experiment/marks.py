@@ -1,10 +1,10 @@
 """What the per-cluster figures (Figs. 6-12) mark, computed once from the identification.
 
 The convergence marker and the steady-state line come from ``ident.convergence`` and
-``ident.model``: the :func:`clpc.appraiser.convergence.convergence` verdict and the
-:func:`~clpc.appraiser.convergence.steady_state_model` that the report's claims read
-(:func:`clpc.experiment.statistics.parameter_statistics`), over the same trusted updates
-(:func:`clpc.appraiser.convergence.usable`). Nothing here draws; :mod:`.figures` does.
+``ident.model``: the :meth:`clpc.Trace.convergence` verdict and the
+:meth:`~clpc.Trace.steady_state_model` that the report's claims read
+(:func:`clpc_paper.experiment.statistics.parameter_statistics`), over the same trusted updates
+(:func:`clpc.appraiser.usable`). Nothing here draws; :mod:`.figures` does.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from clpc.appraiser.convergence import usable
+from clpc.appraiser import usable
 from clpc_paper.experiment.analysis import constant_windows
 from clpc_paper.experiment.results import Identification
 from clpc_paper.experiment.settings import TOLERANCES

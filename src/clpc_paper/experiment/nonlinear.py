@@ -3,7 +3,7 @@
 Section V of the paper promises that globally nonlinear data are locally linear in time
 windows, so clusters identify better than one global fit. The servo of section VI is
 linear at the paper's amplitudes; this part runs the crank servo of
-:mod:`clpc.plants.crank_servo` (gravity and inertia that change with the angle) and its
+:mod:`clpc_paper.plants.crank_servo` (gravity and inertia that change with the angle) and its
 negative control (the same plant with the velocity integrator on), each identified from
 random command levels and judged on new levels and on a slow triangle sweep, with
 
@@ -26,12 +26,10 @@ from typing import Any
 
 import numpy as np
 
-from clpc.analysis.metrics import fit_percent
-from clpc.analysis.operating_point import operating_point_diagnostics
-from clpc.appraiser import CLPC
-from clpc.lpc import ARX, LPC
-from clpc.multimodel import MultiModel, simulate_time_varying
-from clpc_paper.experiment.nonlinear_figures import fig_fits, plot_multimodel
+from clpc import ARX, CLPC, LPC, MultiModel, fit_percent, operating_point_diagnostics
+from clpc.multimodel import simulate_time_varying
+from clpc.plotting import plot_multimodel
+from clpc_paper.experiment.nonlinear_figures import fig_fits
 from clpc_paper.plants.crank_servo import (
     CrankParameters,
     crank_commands,

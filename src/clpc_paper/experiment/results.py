@@ -7,8 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser.trace import Convergence, Trace
-from clpc.model import LinearModel
+from clpc import Convergence, LinearModel, Trace
 
 __all__ = ["CommandResult", "Identification", "TorqueCheck"]
 
@@ -24,7 +23,7 @@ class Identification:
     convergence : Convergence
         Verdict used for the steady-state model.
     level : int
-        Index in :data:`~clpc.experiment.settings.TOLERANCES` of the tolerances that
+        Index in :data:`~clpc_paper.experiment.settings.TOLERANCES` of the tolerances that
         converged, -1 if none did.
     model : LinearModel
         Steady-state model (mean theta after convergence, else the last accepted one).

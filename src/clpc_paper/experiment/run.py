@@ -1,16 +1,16 @@
 """The paper's section VI experiment, end to end, on the simulated brushless servo.
 
 ``run_experiment(out_dir)`` simulates the position-controlled servo of Fig. 4
-(:mod:`clpc.plants`), runs the CLPC appraiser with the settings of Table 1 on two
+(:mod:`clpc_paper.plants`), runs the CLPC appraiser with the settings of Table 1 on two
 identifications,
 
 * (a) the control system, position command -> measured position (Figs. 6-12, 15-17);
 * (b) the motor as actuator, torque command -> measured position (Figs. 13-14);
 
-and writes the paper's Figs. 5-17 (:mod:`clpc.experiment.figures`), ``summary.json`` (the
+and writes the paper's Figs. 5-17 (:mod:`clpc_paper.experiment.figures`), ``summary.json`` (the
 numbers behind them), ``report.md`` (every figure beside the claim it tests,
-:mod:`clpc.experiment.report`) and ``report.html`` (the same text as a web page,
-:mod:`clpc.experiment.html_report`).
+:mod:`clpc_paper.experiment.report`) and ``report.html`` (the same text as a web page,
+:mod:`clpc_paper.experiment.html_report`).
 
 Two commands are used. The paper's ramp with saturation (Fig. 5) gives the main figures;
 it excites the loop only while it ramps (its second difference is zero except at the two
@@ -20,7 +20,7 @@ moves repeated with a 2 s period (the window length) plus a small PRBS dither.
 Signals flow as on a real drive: the servo is logged at 1 ms (the drive's trace buffer)
 and the appraiser works at Table 1's 10 ms ``sample_time``, anti-alias filtering and
 decimating the log itself (:class:`clpc.CLPC` with ``dt`` 1 ms, ``decimate_to`` 10 ms). Every model
-is evaluated on the same decimated signals (:func:`clpc.appraiser.decimation.decimate` is
+is evaluated on the same decimated signals (:func:`clpc.appraiser.decimate` is
 the appraiser's own filter).
 
 Data flow (no module imports one above it): ``settings`` -> ``results`` -> ``analysis``,
@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core.jsonable import jsonable
+from clpc.report import jsonable
 from clpc_paper.experiment.claims import claims
 from clpc_paper.experiment.evaluation import (
     aliasing_check,

@@ -171,8 +171,8 @@ def section_torque(summary: dict[str, Any]) -> list[str]:
         "Sampling a double integrator puts a zero of B(z) outside the unit circle, so the "
         "causal inverse (`LinearModel.infer_input`) is unstable; for the ramp model it "
         f'answers: "{act_r["causal_inverse"]}" The figures use the stable non-causal '
-        "inverse (`clpc.experiment.stable_inverse`: zeros inside the circle inverted forwards, "
-        "outside backwards in time, both started at rest/settled), valid offline.\n\n"
+        "inverse (`clpc_paper.experiment.stable_inverse`: zeros inside the circle inverted "
+        "forwards, outside backwards in time, both started at rest/settled), valid offline.\n\n"
         "What limits it, measured: (1) the servo logs the torque as its mean over each 1 ms "
         "(what the motor integrates); one controller sample per period put the velocity "
         "loop's noise torque, which never moves the motor, into the log. (2) Coulomb "

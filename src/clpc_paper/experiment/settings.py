@@ -1,6 +1,6 @@
 """Settings of the section VI experiment: Table 1, the two commands, the claim thresholds.
 
-Everything the other modules of :mod:`clpc.experiment` share as a constant lives here, and
+Everything the other modules of :mod:`clpc_paper.experiment` share as a constant lives here, and
 :func:`settings_record` is the ``settings`` block of ``summary.json``.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from clpc.core.checks import check_positive
+from clpc_paper.checks import check_positive
 
 __all__ = [
     "A0_MIN",
@@ -52,7 +52,7 @@ class Ramp:
 
 @dataclass(frozen=True)
 class Moves:
-    """Ramp-and-hold moves (:func:`clpc.plants.trapezoid_moves`) [rad, rad/s, rad/s^2, s]."""
+    """Ramp-and-hold moves (:func:`clpc_paper.plants.trapezoid_moves`) [rad, rad/s, rad/s^2, s]."""
 
     positions: tuple[float, float]
     max_velocity: float
@@ -63,7 +63,7 @@ class Moves:
 
 @dataclass(frozen=True)
 class Dither:
-    """PRBS dither (:func:`clpc.plants.prbs`) [rad, s]."""
+    """PRBS dither (:func:`clpc_paper.plants.prbs`) [rad, s]."""
 
     amplitude: float
     min_hold: float

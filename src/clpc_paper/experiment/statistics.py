@@ -1,7 +1,7 @@
 """The numbers behind the paper's figures: D, the parameters, the models, the rigid body.
 
 Each function turns a trace, an identification or a model into a JSON-ready dict of the
-``summary.json`` written by :func:`clpc.experiment.run_experiment`.
+``summary.json`` written by :func:`clpc_paper.experiment.run_experiment`.
 """
 
 from __future__ import annotations
@@ -11,9 +11,8 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from clpc.appraiser.convergence import usable
-from clpc.appraiser.trace import Trace
-from clpc.model import LinearModel
+from clpc import LinearModel, Trace
+from clpc.appraiser import usable
 from clpc_paper.experiment.results import Identification
 from clpc_paper.experiment.settings import A0_MIN, D_QUASI_CONSTANT, LABELS, WINDOW_SIZE
 from clpc_paper.plants import ServoParameters

@@ -1,6 +1,6 @@
 """Position commands for the simulated servo (and any other plant).
 
-Every generator returns a 1-D float64 array sampled on :func:`clpc.plants.grid.time_grid`
+Every generator returns a 1-D float64 array sampled on :func:`clpc_paper.plants.grid.time_grid`
 (``t_k = k * sample_time``, both ends of ``[0, duration]`` included). Positions are in
 rad, times in s.
 
@@ -10,7 +10,7 @@ rad, times in s.
 * :func:`trapezoid_moves` - repeated point-to-point moves with velocity and acceleration
   limits (trapezoidal velocity profile) and dwell.
 
-The excitation signals (chirp, PRBS, multisine) are in :mod:`clpc.plants.excitation`; they
+The excitation signals (chirp, PRBS, multisine) are in :mod:`clpc_paper.plants.excitation`; they
 are re-exported here, where they used to live.
 """
 
@@ -20,10 +20,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from clpc.core.checks import check_int
-from clpc.core.checks import check_nonnegative as nonnegative
-from clpc.core.checks import check_positive as positive
-from clpc.core.checks import check_real as real
+from clpc_paper.checks import check_int
+from clpc_paper.checks import check_nonnegative as nonnegative
+from clpc_paper.checks import check_positive as positive
+from clpc_paper.checks import check_real as real
 from clpc_paper.plants.excitation import chirp, multisine, prbs
 from clpc_paper.plants.grid import EPS, first_index, sample_grid, time_grid
 from clpc_paper.plants.moves import MoveCycle, fill_moves

@@ -1,7 +1,7 @@
 """Excitation signals: swept sine, PRBS-like random steps, multisine.
 
 Every generator returns ``offset + amplitude * shape`` as a 1-D float64 array sampled on
-:func:`clpc.plants.grid.time_grid` (``t_k = k * sample_time``); positions are in rad,
+:func:`clpc_paper.plants.grid.time_grid` (``t_k = k * sample_time``); positions are in rad,
 times in s, frequencies in Hz.
 
 * :func:`chirp` - a swept sine (linear or logarithmic);
@@ -17,10 +17,10 @@ from typing import Literal
 
 import numpy as np
 
-from clpc.core.checks import check_choice, check_int
-from clpc.core.checks import check_nonnegative as nonnegative
-from clpc.core.checks import check_positive as positive
-from clpc.core.checks import check_real as real
+from clpc_paper.checks import check_choice, check_int
+from clpc_paper.checks import check_nonnegative as nonnegative
+from clpc_paper.checks import check_positive as positive
+from clpc_paper.checks import check_real as real
 from clpc_paper.plants.grid import sample_grid
 
 __all__ = ["chirp", "multisine", "prbs"]

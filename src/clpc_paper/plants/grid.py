@@ -13,8 +13,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from clpc.core.checks import check_nonnegative as nonnegative
-from clpc.core.checks import check_positive as positive
+from clpc_paper.checks import check_nonnegative as nonnegative
+from clpc_paper.checks import check_positive as positive
 
 __all__ = ["EPS", "Grid", "first_index", "sample_grid", "time_grid"]
 

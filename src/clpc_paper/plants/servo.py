@@ -108,7 +108,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from clpc.core.checks import check_real as real
+from clpc_paper.checks import check_real as real
 from clpc_paper.plants.servo_inputs import _check_params, _check_rates, _check_signal, _streams
 from clpc_paper.plants.servo_layout import _O_TAU, _O_VCMD
 from clpc_paper.plants.servo_loop import numba_available
@@ -178,7 +178,7 @@ def simulate_servo(
     Examples
     --------
     >>> import numpy as np
-    >>> from clpc.plants import simulate_servo
+    >>> from clpc_paper.plants import simulate_servo
     >>> rec = simulate_servo(np.r_[np.zeros(10), np.ones(90)], seed=0)
     >>> bool(abs(rec.true_position[-1] - 1.0) < 1e-3)
     True

@@ -1,4 +1,4 @@
-"""Checks of the arguments of :func:`~clpc.plants.simulate_servo` and its open-loop twin."""
+"""Checks of the arguments of :func:`~clpc_paper.plants.simulate_servo` and its open-loop twin."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core.checks import REAL
+from clpc_paper.checks import REAL
 from clpc_paper.plants.servo_parameters import ServoParameters
 
 __all__: list[str] = []

@@ -1,6 +1,6 @@
 """What the servo loop works on: packed parameters, carried state, logged outputs.
 
-The loop (:mod:`clpc.plants.servo_loop`) takes flat float64 arrays so that numba compiles
+The loop (:mod:`clpc_paper.plants.servo_loop`) takes flat float64 arrays so that numba compiles
 it once for every parameter set; this module fixes their layout and fills them:
 
 * ``p``, shape ``(_N_P,)``: the parameters (see the ``_P_*`` indices), from :func:`_pack`;

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from clpc.core import jit
-from clpc.core.checks import check_choice
 from clpc.core.jit import kernel
+from clpc_paper.checks import check_choice
 from clpc_paper.plants.servo_kernels import (
     _clip,
     _drive_step,

@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core.checks import REAL
-from clpc.core.checks import check_nonnegative as nonnegative
-from clpc.core.checks import check_positive as positive
-from clpc.core.checks import check_real as real
+from clpc_paper.checks import REAL
+from clpc_paper.checks import check_nonnegative as nonnegative
+from clpc_paper.checks import check_positive as positive
+from clpc_paper.checks import check_real as real
 
 __all__ = ["ServoParameters"]
 

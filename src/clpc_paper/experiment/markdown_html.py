@@ -1,6 +1,6 @@
 r"""The small Markdown subset the reports emit, as HTML (no dependency).
 
-Handles what :mod:`clpc.experiment` writes into ``report.md``: ``#``/``##`` headings,
+Handles what :mod:`clpc_paper.experiment` writes into ``report.md``: ``#``/``##`` headings,
 paragraphs, pipe tables (``\|`` escapes a bar inside a cell), images on their own line
 (an image followed by a paragraph opening with its caption in ``*...*`` becomes one
 ``<figure>``), bullet lists (continuation lines indented), block quotes and inline
