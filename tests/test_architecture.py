@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import re
 from pathlib import Path
 
 import pytest
@@ -305,6 +306,18 @@ def test_the_plants_do_not_import_the_experiment():
         and mod != "clpc_paper.checks"
     ]
     assert bad == []
+
+
+def test_architecture_md_names_every_paper_module():
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "architecture.md").read_text(
+        encoding="utf-8"
+    )
+    start = doc.index("## The paper's application")
+    section = doc[start : doc.index("\n## ", start)]
+    named = set(re.findall(r"`([\w/]+\.py)`", section))
+    files = {p.relative_to(PAPER).as_posix() for p in PAPER.rglob("*.py")}
+    assert sorted(files - named) == []  # every module is named
+    assert sorted(named - files) == []  # every module named exists
 
 
 def test_the_paper_checks_see_a_violation():
