@@ -495,7 +495,7 @@ def test_demo_reports_missing_experiment(monkeypatch, tmp_path):
 
 def test_demo_quick(tmp_path):
     if importlib.util.find_spec("clpc_paper.experiment") is None:
-        pytest.skip("clpc.experiment (the motor experiment) is not in this tree yet")
+        pytest.skip("clpc_paper.experiment (the motor experiment) is not in this tree yet")
     res = ok("demo", "--out", tmp_path, "--quick", "--duration", "3")
     assert "motor experiment finished" in res.output
     assert (tmp_path / "summary.json").exists()

@@ -1,4 +1,4 @@
-"""The section VI experiment (clpc.experiment): outputs, the paper's claims, the helpers.
+"""The section VI experiment (clpc_paper.experiment): outputs, the paper's claims, the helpers.
 
 One shortened run (``quick=True``) is shared by the module; every assertion on it checks a
 property the rig could fail (a stable control-system model, a pole at z = 1, D settling),

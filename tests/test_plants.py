@@ -1,4 +1,4 @@
-"""Tests of the simulated servo (clpc.plants.servo) and the command generators."""
+"""Tests of the simulated servo (clpc_paper.plants.servo) and the command generators."""
 
 from __future__ import annotations
 
