@@ -320,6 +320,14 @@ def test_architecture_md_names_every_paper_module():
     assert sorted(named - files) == []  # every module named exists
 
 
+def test_no_paper_module_is_over_300_lines():
+    sizes = {
+        name: len(path.read_text(encoding="utf-8").splitlines())
+        for name, path in _paper_modules().items()
+    }
+    assert {name: n for name, n in sizes.items() if n > 300} == {}
+
+
 def test_the_paper_checks_see_a_violation():
     # the checks themselves must be able to fail
     assert _library_uses_of_paper("clpc.lpc.arx", "import clpc_paper.plants\n")

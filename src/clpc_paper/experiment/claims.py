@@ -13,18 +13,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from clpc_paper.experiment.actuator_checks import check_actuator, check_torque
 from clpc_paper.experiment.claim_checks import (
     NOT_REPRODUCED,
     PARTLY,
     REPRODUCED,
-    check_actuator,
     check_clusters,
     check_corner,
     check_d,
     check_parameters,
     check_position,
     check_stable,
-    check_torque,
     fmt,
     fmt_poles,
 )
