@@ -1,6 +1,6 @@
 """Multi-models (issue 18): the crank servo over seeds, the cascaded tanks, D, and speed.
 
-1. The crank servo (``clpc.plants.crank_servo``) and its negative control (velocity
+1. The crank servo (``clpc_paper.plants.crank_servo``) and its negative control (velocity
    integrator 10 /s), the demo's full-size records (60 levels of 6 s for identification;
    30 new levels and a 4-leg 30 s triangle sweep for validation), seeds 0..4: validation
    free-run fit % of global LPC, global least squares, the CLPC steady-state model and
@@ -29,7 +29,7 @@ from scipy import stats
 import clpc
 from clpc import datasets
 from clpc.analysis.operating_point import operating_point_diagnostics, window_means
-from clpc.plants.crank_servo import CrankParameters, crank_commands, simulate_crank_servo
+from clpc_paper.plants.crank_servo import CrankParameters, crank_commands, simulate_crank_servo
 
 START = 203
 

@@ -5,7 +5,7 @@ Runs the paper's ramp (Fig. 5) on the simulated servo logged at every controller
 (what the log recorded before) and the mean over each millisecond (what it records now).
 Each is decimated to the appraiser's 10 ms like the position, and scored by the fit of the
 best linear estimate of the torque from the measured position (least squares on the record
-itself, ``clpc.experiment.analysis.linear_bound``), with and without Coulomb friction.
+itself, ``clpc_paper.experiment.analysis.linear_bound``), with and without Coulomb friction.
 
     python benchmarks/torque_logging.py
 """
@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from clpc.appraiser.decimation import decimate
-from clpc.experiment.analysis import linear_bound
-from clpc.experiment.settings import RAMP, RAMP_DURATION
-from clpc.plants import ServoParameters, ramp_with_saturation, simulate_servo
+from clpc_paper.experiment.analysis import linear_bound
+from clpc_paper.experiment.settings import RAMP, RAMP_DURATION
+from clpc_paper.plants import ServoParameters, ramp_with_saturation, simulate_servo
 
 
 def main() -> None:

@@ -2,17 +2,23 @@
 
 Every ``import`` in ``src/clpc`` (module level and inside functions) is parsed with ``ast``;
 each module belongs to the layer of its longest matching prefix in ``LAYERS``.
+
+The paper's application ``src/clpc_paper`` sits beside the library: it imports clpc's public
+API only (``PUBLIC``), and the library imports it in one place, the ``clpc demo`` command
+(``PAPER_ENTRY``), inside the command's function.
 """
 
 from __future__ import annotations
 
 import ast
 import importlib
+import re
 from pathlib import Path
 
 import pytest
 
 import clpc
+import clpc_paper
 from clpc._moved import MOVED
 
 SRC = Path(clpc.__file__).resolve().parent
@@ -27,9 +33,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("clpc.analysis",),
     ("clpc.multimodel",),
     ("clpc.io", "clpc.datasets"),
-    ("clpc.plants",),
     ("clpc.plotting", "clpc.report"),
-    ("clpc.experiment",),
     ("clpc.workflows",),
     ("clpc.cli", "clpc.__main__"),
     ("clpc", "clpc._moved"),  # the package facade re-exports everything
@@ -143,3 +147,210 @@ def test_the_layer_check_sees_a_violation():
 @pytest.mark.parametrize(("old", "new"), sorted(MOVED.items()))
 def test_old_module_paths_still_import(old, new):
     assert importlib.import_module(old) is importlib.import_module(new)
+
+
+# ================================================================= the paper's application
+PAPER = Path(clpc_paper.__file__).resolve().parent
+
+#: (module, function): the one place the library imports clpc_paper, inside the command
+PAPER_ENTRY = ("clpc.cli.info", "demo")
+
+#: what clpc_paper may import: ``clpc`` (names in ``clpc.__all__``) and these subpackages
+#: (names in their ``__all__``); nothing deeper, nothing private
+PUBLIC = (
+    "clpc",
+    "clpc.appraiser",
+    "clpc.datasets",
+    "clpc.multimodel",
+    "clpc.plotting",
+    "clpc.report",
+)
+
+#: library modules the plants still import although they are not public, and why (each for
+#: the modules under one prefix only)
+TOLERATED = {
+    "clpc.core.jit": (
+        "clpc_paper.plants.",
+        "the servo's compiled loops are written with the engine's kernel/compiled (issue 24 "
+        "point 3 replaces both by plain numba.njit)",
+    ),
+}
+
+
+def _sites(source: str, name: str, package: bool) -> list[tuple[str, tuple[str, ...], str]]:
+    """Every import in ``source``: (absolute module, names taken from it, enclosing function).
+
+    ``import a.b`` gives ``("a.b", (), fn)``; ``from a import x, y`` gives ``("a", ("x", "y"),
+    fn)``; ``fn`` is the innermost function around the import ("" at module level).
+    """
+    base = name.split(".") if package else name.split(".")[:-1]
+    found: list[tuple[str, tuple[str, ...], str]] = []
+
+    def visit(node: ast.AST, fn: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = child.name if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)) else fn
+            if isinstance(child, ast.Import):
+                found.extend((a.name, (), fn) for a in child.names)
+            elif isinstance(child, ast.ImportFrom):
+                mod = child.module or ""
+                if child.level:
+                    mod = ".".join(base[: len(base) - child.level + 1] + ([mod] if mod else []))
+                found.append((mod, tuple(a.name for a in child.names), fn))
+            visit(child, inner)
+
+    visit(ast.parse(source), "")
+    return found
+
+
+def _top(module: str) -> str:
+    return module.split(".")[0]
+
+
+def _library_uses_of_paper(name: str, source: str, package: bool = False) -> list[str]:
+    """Imports of clpc_paper by library module ``name`` outside ``PAPER_ENTRY``."""
+    return [
+        f"{name}{'.' + fn if fn else ''} imports {mod}"
+        for mod, _, fn in _sites(source, name, package)
+        if _top(mod) == "clpc_paper" and (name, fn) != PAPER_ENTRY
+    ]
+
+
+def _public_names(module: str) -> set[str]:
+    return set(getattr(importlib.import_module(module), "__all__", ()))
+
+
+def _tolerated(name: str, module: str) -> bool:
+    rule = TOLERATED.get(module)
+    return rule is not None and name.startswith(rule[0])
+
+
+def _private_uses(name: str, source: str, package: bool = False) -> list[str]:
+    """Imports of the library by clpc_paper module ``name`` that are not public API."""
+    bad = []
+    for mod, names, _ in _sites(source, name, package):
+        if _top(mod) != "clpc" or _tolerated(name, mod):
+            continue
+        kept = tuple(n for n in names if not _tolerated(name, f"{mod}.{n}"))  # from a import b
+        if names and not kept:
+            continue
+        if mod not in PUBLIC:
+            bad.append(f"{name} imports {mod}")
+            continue
+        allowed = _public_names(mod) | {
+            p.rpartition(".")[2] for p in PUBLIC if p.startswith(mod + ".")
+        }
+        bad.extend(
+            f"{name} imports {mod}.{n}" for n in kept if n not in allowed or n.startswith("_")
+        )
+    return bad
+
+
+def _paper_modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PAPER.rglob("*.py")):
+        parts = list(path.relative_to(PAPER.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        out[".".join(parts)] = path
+    return out
+
+
+def test_the_library_imports_the_paper_only_in_the_demo_command():
+    bad = [
+        use
+        for path in sorted(SRC.rglob("*.py"))
+        for use in _library_uses_of_paper(
+            _module_name(path), path.read_text(encoding="utf-8"), path.name == "__init__.py"
+        )
+    ]
+    assert bad == []
+
+
+def test_the_demo_command_imports_the_paper():
+    module, fn = PAPER_ENTRY
+    path = SRC.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    sites = _sites(path.read_text(encoding="utf-8"), module, False)
+    assert any(_top(mod) == "clpc_paper" and where == fn for mod, _, where in sites)
+
+
+def test_the_paper_imports_public_api_only():
+    bad = [
+        use
+        for name, path in _paper_modules().items()
+        for use in _private_uses(name, path.read_text(encoding="utf-8"), path.name == "__init__.py")
+    ]
+    assert bad == []
+
+
+def test_the_tolerated_private_imports_are_still_used():
+    # an exception nobody needs any more goes
+    used = {
+        target
+        for name, path in _paper_modules().items()
+        for mod, names, _ in _sites(
+            path.read_text(encoding="utf-8"), name, path.name == "__init__.py"
+        )
+        for target in (mod, *(f"{mod}.{n}" for n in names))
+    }
+    assert set(TOLERATED) <= used
+
+
+def test_the_plants_do_not_import_the_experiment():
+    bad = [
+        f"{name} imports {mod}"
+        for name, path in _paper_modules().items()
+        if name.startswith("clpc_paper.plants")
+        for mod, _, _ in _sites(path.read_text(encoding="utf-8"), name, path.name == "__init__.py")
+        if _top(mod) == "clpc_paper"
+        and not mod.startswith("clpc_paper.plants")
+        and mod != "clpc_paper.checks"
+    ]
+    assert bad == []
+
+
+def test_architecture_md_names_every_paper_module():
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "architecture.md").read_text(
+        encoding="utf-8"
+    )
+    start = doc.index("## The paper's application")
+    section = doc[start : doc.index("\n## ", start)]
+    named = set(re.findall(r"`([\w/]+\.py)`", section))
+    files = {p.relative_to(PAPER).as_posix() for p in PAPER.rglob("*.py")}
+    assert sorted(files - named) == []  # every module is named
+    assert sorted(named - files) == []  # every module named exists
+
+
+def test_no_paper_module_is_over_300_lines():
+    sizes = {
+        name: len(path.read_text(encoding="utf-8").splitlines())
+        for name, path in _paper_modules().items()
+    }
+    assert {name: n for name, n in sizes.items() if n > 300} == {}
+
+
+def test_the_paper_checks_see_a_violation():
+    # the checks themselves must be able to fail
+    assert _library_uses_of_paper("clpc.lpc.arx", "import clpc_paper.plants\n")
+    assert _library_uses_of_paper(
+        "clpc.report.track", "def f():\n    from clpc_paper import demo\n"
+    )
+    module, fn = PAPER_ENTRY
+    assert _library_uses_of_paper(module, "from clpc_paper.demo import run_demo\n")
+    assert not _library_uses_of_paper(module, f"def {fn}():\n    from clpc_paper import demo\n")
+    paper = "clpc_paper.experiment.run"
+    assert _private_uses(paper, "from clpc.lpc.estimator import LPC\n")
+    assert _private_uses(paper, "from clpc.core import checks\n")
+    assert _private_uses(paper, "import clpc._moved\n")
+    assert _private_uses(paper, "from clpc import _moved\n")
+    assert _private_uses(paper, "from clpc import core\n")
+    assert _private_uses(paper, "from clpc.appraiser import convergence\n")
+    assert _private_uses(paper, "from clpc.core.jit import kernel\n")  # tolerated in plants only
+    assert _private_uses(paper, "from clpc.core import jit\n")
+    plant = "clpc_paper.plants.servo_loop"
+    assert (
+        _private_uses(plant, "from clpc.core import jit\nfrom clpc.core.jit import kernel\n") == []
+    )
+    assert _private_uses(plant, "from clpc.core import jit, checks\n")
+    assert _private_uses(paper, "from ..x import y\n") == []
+    assert _private_uses(paper, "from clpc import LPC, plotting\nimport clpc\n") == []
+    assert _private_uses(paper, "from clpc.plotting import plot_multimodel\n") == []

@@ -487,15 +487,15 @@ def test_usage_errors_exit_2(record, tmp_path):
 
 # ================================================================= demo
 def test_demo_reports_missing_experiment(monkeypatch, tmp_path):
-    for name in ("clpc.experiment", "clpc.experiment.run"):
+    for name in ("clpc_paper", "clpc_paper.demo"):
         monkeypatch.setitem(sys.modules, name, None)  # import now fails
     r = fails(1, "demo", "--out", tmp_path)
-    assert "needs clpc.experiment" in r.output
+    assert "needs clpc_paper" in r.output
 
 
 def test_demo_quick(tmp_path):
-    if importlib.util.find_spec("clpc.experiment") is None:
-        pytest.skip("clpc.experiment (the motor experiment) is not in this tree yet")
+    if importlib.util.find_spec("clpc_paper.experiment") is None:
+        pytest.skip("clpc_paper.experiment (the motor experiment) is not in this tree yet")
     res = ok("demo", "--out", tmp_path, "--quick", "--duration", "3")
     assert "motor experiment finished" in res.output
     assert (tmp_path / "summary.json").exists()

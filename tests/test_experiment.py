@@ -1,4 +1,4 @@
-"""The section VI experiment (clpc.experiment): outputs, the paper's claims, the helpers.
+"""The section VI experiment (clpc_paper.experiment): outputs, the paper's claims, the helpers.
 
 One shortened run (``quick=True``) is shared by the module; every assertion on it checks a
 property the rig could fail (a stable control-system model, a pole at z = 1, D settling),
@@ -18,10 +18,10 @@ import pytest
 from scipy import signal
 
 import clpc
-from clpc.experiment import analysis, decimate, settings
-from clpc.experiment import run as ex
-from clpc.experiment.figures import FILES, RICH_FILE
-from clpc.experiment.report import render_report
+from clpc_paper.experiment import analysis, decimate, settings
+from clpc_paper.experiment import run as ex
+from clpc_paper.experiment.figures import FILES, RICH_FILE
+from clpc_paper.experiment.report import render_report
 from test_report_html import check_images, heading_index, parse, render_in_chromium
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

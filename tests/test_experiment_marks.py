@@ -14,15 +14,15 @@ import pytest
 from scipy import signal
 
 from clpc.appraiser.convergence import convergence, usable
-from clpc.experiment import analysis
-from clpc.experiment.figures import draw_parameter
-from clpc.experiment.identification import find_convergence, identify
-from clpc.experiment.marks import estimate_series, parameter_marks, window_states
-from clpc.experiment.results import Identification
-from clpc.experiment.run import commands
-from clpc.experiment.settings import LOG_SAMPLE_TIME, RAMP_DURATION, TOLERANCES
-from clpc.experiment.statistics import parameter_statistics
-from clpc.plants import ServoParameters, simulate_servo
+from clpc_paper.experiment import analysis
+from clpc_paper.experiment.figures import draw_parameter
+from clpc_paper.experiment.identification import find_convergence, identify
+from clpc_paper.experiment.marks import estimate_series, parameter_marks, window_states
+from clpc_paper.experiment.results import Identification
+from clpc_paper.experiment.run import commands
+from clpc_paper.experiment.settings import LOG_SAMPLE_TIME, RAMP_DURATION, TOLERANCES
+from clpc_paper.experiment.statistics import parameter_statistics
+from clpc_paper.plants import ServoParameters, simulate_servo
 
 
 @pytest.fixture(scope="module")

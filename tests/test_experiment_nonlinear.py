@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from clpc.core.jsonable import jsonable
-from clpc.experiment.nonlinear import (
+from clpc_paper.experiment.nonlinear import (
     CLAIM_MARGIN,
     nonlinear_claim,
     run_nonlinear,
@@ -40,7 +40,7 @@ def test_nonlinear_part_judges_the_claim_on_the_plant_and_its_control(tmp_path):
 
 
 def test_verdict_table_shows_the_crank_servo_verdicts() -> None:
-    from clpc.experiment.markdown import verdict_table
+    from clpc_paper.experiment.markdown import verdict_table
 
     claim = {
         "paper": "clusters identify better than one global fit (crank servo)",

@@ -14,7 +14,7 @@ from clpc.lpc.heldout import fit_percent
 from clpc.multimodel import simulate_time_varying
 from clpc.multimodel.local import fit_local, weighted_lpc
 from clpc.multimodel.validity import validity
-from clpc.plants.crank_servo import (
+from clpc_paper.plants.crank_servo import (
     CrankParameters,
     crank_commands,
     crank_operating_point,

@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 import clpc
 from clpc.cli.app import cli
-from clpc.plants.crank_servo import crank_commands, simulate_crank_servo
+from clpc_paper.plants.crank_servo import crank_commands, simulate_crank_servo
 
 
 def test_multimodel_command_saves_a_model_that_simulates_the_same(tmp_path):

@@ -1,4 +1,4 @@
-"""Tests of the simulated servo (clpc.plants.servo) and the command generators."""
+"""Tests of the simulated servo (clpc_paper.plants.servo) and the command generators."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from clpc.plants import (
+from clpc_paper.plants import (
     ServoParameters,
     chirp,
     multisine,

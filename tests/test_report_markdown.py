@@ -1,8 +1,8 @@
-"""The Markdown subset of the reports as HTML (clpc.report.markdown), against hand-written HTML."""
+"""The Markdown subset of the experiment's report as HTML (clpc_paper.experiment.markdown_html)."""
 
 from __future__ import annotations
 
-from clpc.report.markdown import inline, markdown_to_html, split_sections
+from clpc_paper.experiment.markdown_html import inline, markdown_to_html, split_sections
 
 
 def test_inline_spans_and_escaping() -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from clpc.plants import ServoParameters, ramp_with_saturation, simulate_servo
+from clpc_paper.plants import ServoParameters, ramp_with_saturation, simulate_servo
 
 
 def _pair(params: ServoParameters) -> tuple[object, object]:

@@ -27,8 +27,6 @@ MOVED = {
     "clpc.tracefile": "clpc.appraiser.tracefile",
     "clpc.window_kernel": "clpc.appraiser.kernel",
     "clpc.model_io": "clpc.io.model_files",
-    "clpc.experiment_report": "clpc.experiment.report",
-    "clpc.paper_figures": "clpc.experiment.figures",
 }
 
 

@@ -24,7 +24,7 @@ __all__ = [
 ]
 
 #: Relative spread of the windows' DC gains, ``(P90 - P10) / |median|``, above which the
-#: windows disagree. Measured: the crank servo of :mod:`clpc.plants.crank_servo` 0.84-0.93;
+#: windows disagree. Measured: the crank servo of :mod:`clpc_paper.plants.crank_servo` 0.84-0.93;
 #: its negative control with the velocity integrator 0.42-0.46 (its windows are too short to
 #: settle the integrator); linear records of the test suite (a tracked chirp, the quick
 #: demo's actuator) up to 0.32, which the first limit tried (0.25) flagged.

@@ -1,4 +1,8 @@
-"""``clpc datasets`` (the shipped records) and ``clpc demo`` (the paper's experiment)."""
+"""``clpc datasets`` (the shipped records) and ``clpc demo`` (the paper's experiment).
+
+The demo runs :mod:`clpc_paper`, the section VI experiment built on the library; only
+:func:`demo` imports it, when it runs.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +14,7 @@ import click
 from clpc.cli.errors import ClpcCommand
 from clpc.cli.options import json_option, method_option, out_dir_option
 from clpc.cli.output import echo_json
-from clpc.workflows import DatasetEntry, list_datasets, run_demo
+from clpc.workflows import DatasetEntry, list_datasets
 
 __all__ = ["datasets", "demo"]
 
@@ -90,6 +94,12 @@ def demo(
     Example:
       clpc demo --out demo/ --quick
     """  # noqa: D301
+    try:  # the experiment is an application of the library, imported only here
+        from clpc_paper.demo import run_demo
+    except ImportError as exc:
+        raise ImportError(
+            f"the demo needs clpc_paper, which is not available here ({exc})."
+        ) from None
     with warnings.catch_warnings(record=True) as caught:  # one plain line each, no source
         warnings.simplefilter("always", UserWarning)
         result = run_demo(out_dir, duration=duration, quick=quick, seed=seed, method=method)

@@ -14,6 +14,7 @@ has the same colour in every figure (:data:`clpc.core.figure.COLORS`); records l
 """
 
 from clpc.core.figure import COLORS, MAX_POINTS, envelope
+from clpc.plotting.multimodel import plot_multimodel
 from clpc.plotting.records import plot_compare, plot_data, plot_fit
 from clpc.plotting.residuals import plot_residuals
 from clpc.plotting.responses import bode_frequencies, plot_bode, plot_pz, plot_step
@@ -28,6 +29,7 @@ __all__ = [
     "plot_compare",
     "plot_data",
     "plot_fit",
+    "plot_multimodel",
     "plot_pz",
     "plot_residuals",
     "plot_step",

@@ -8,7 +8,7 @@ them from here.
 from clpc.appraiser.tracefile import trace_columns
 from clpc.core.jsonable import jsonable
 from clpc.report.comparison import Comparison, compare
-from clpc.report.html import Section, write_html_report
+from clpc.report.html import Section, warnings_html, write_html_report
 from clpc.report.identify import write_identify_report
 from clpc.report.summaries import (
     model_response,
@@ -35,6 +35,7 @@ __all__ = [
     "trace_summary",
     "update_records",
     "verdict_text",
+    "warnings_html",
     "write_html_report",
     "write_identify_report",
     "write_track_report",

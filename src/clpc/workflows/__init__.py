@@ -5,7 +5,7 @@ files, and returns a result object; :mod:`clpc.cli` only parses options, calls a
 and prints its result.
 """
 
-from clpc.workflows.catalog import DatasetEntry, DemoResult, list_datasets, run_demo
+from clpc.workflows.catalog import DatasetEntry, list_datasets
 from clpc.workflows.common import (
     AppraiserSettings,
     ChannelCountError,
@@ -39,7 +39,6 @@ __all__ = [
     "CompareResult",
     "CompareSettings",
     "DatasetEntry",
-    "DemoResult",
     "IdentifyResult",
     "IdentifySettings",
     "RecordSpec",
@@ -54,7 +53,6 @@ __all__ = [
     "count_data_lines",
     "identify_file",
     "list_datasets",
-    "run_demo",
     "simulate_file",
     "stream_samples",
     "track_file",

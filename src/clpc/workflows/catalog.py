@@ -1,14 +1,13 @@
-"""The shipped records and the paper's experiment."""
+"""The shipped records (``clpc datasets``)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from clpc import datasets as _datasets
 
-__all__ = ["DatasetEntry", "DemoResult", "list_datasets", "run_demo"]
+__all__ = ["DatasetEntry", "list_datasets"]
 
 
 @dataclass(frozen=True)
@@ -85,63 +84,3 @@ def list_datasets() -> list[DatasetEntry]:
             )
         )
     return entries
-
-
-@dataclass(frozen=True)
-class DemoResult:
-    """The outcome of :func:`run_demo`.
-
-    Attributes
-    ----------
-    summary : dict
-        The experiment's summary (see :func:`clpc.experiment.run.run_experiment`).
-    written : list of str
-        Names of the files in the output folder, sorted.
-    """
-
-    summary: dict[str, Any]
-    written: list[str]
-
-
-def run_demo(
-    out_dir: str,
-    *,
-    quick: bool = False,
-    duration: float | None = None,
-    seed: int = 0,
-    method: str = "robust",
-) -> DemoResult:
-    """Run the paper's brushless-servo experiment (simulated) and write its results.
-
-    Parameters
-    ----------
-    out_dir : str
-        Folder for the figures, tables and report.
-    quick : bool
-        A short run (seconds) for a first look.
-    duration : float, optional
-        Simulated time [s] (default: the paper's).
-    seed : int
-        Random seed.
-    method : {"robust", "paper"}
-        LPC solution.
-
-    Returns
-    -------
-    DemoResult
-        Summary and the files written.
-
-    Raises
-    ------
-    ImportError
-        :mod:`clpc.experiment` is not available.
-    """
-    try:
-        from clpc.experiment.run import run_experiment
-    except ImportError as exc:
-        raise ImportError(
-            f"the demo needs clpc.experiment, which is not available here ({exc})."
-        ) from None
-    summary = run_experiment(out_dir, duration=duration, quick=quick, seed=seed, method=method)
-    written = sorted(p.name for p in Path(out_dir).iterdir() if p.is_file())
-    return DemoResult(summary, written)

@@ -9,9 +9,9 @@ import numpy as np
 
 from clpc.analysis.metrics import fit_percent
 from clpc.core.jsonable import jsonable
-from clpc.experiment.nonlinear_figures import plot_multimodel
 from clpc.lpc import ARX
 from clpc.multimodel import MultiModel
+from clpc.plotting.multimodel import plot_multimodel
 from clpc.workflows.common import RecordSpec
 
 __all__ = ["MultiModelSettings", "multimodel_file"]
