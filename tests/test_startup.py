@@ -69,26 +69,3 @@ def test_help_summary_read_from_source_matches_the_command(name):
     assert command_docstring(name)
     summary = click.Command(name, help=command_docstring(name)).get_short_help_str(60)
     assert summary == command.get_short_help_str(60)
-
-
-def test_compile_notice_once_and_only_for_clpc_kernels(capsys):
-    pytest.importorskip("numba")
-    from types import SimpleNamespace
-
-    from numba.core import event
-
-    from clpc.core import jit
-
-    jit._install_notice()
-    jit._NOTICE["said"] = False
-
-    def compile_event(module: str) -> None:
-        fn = SimpleNamespace(__module__=module)
-        event.start_event("numba:compile", data={"dispatcher": SimpleNamespace(py_func=fn)})
-        event.end_event("numba:compile", data={"dispatcher": SimpleNamespace(py_func=fn)})
-
-    compile_event("someone.else")
-    assert capsys.readouterr().err == ""
-    compile_event("clpc.appraiser.kernel")
-    compile_event("clpc.core.rules")  # the callees compile too: still one line
-    assert capsys.readouterr().err == jit.COMPILE_NOTICE + "\n"

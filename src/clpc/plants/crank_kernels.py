@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
+from numba.extending import register_jitable
 
-from clpc.core.jit import kernel
 from clpc.plants.servo_kernels import _clip, _quantise, _soft_threshold
 
 __all__ = ["N_OUT", "N_P", "N_STATE"]
@@ -28,7 +29,7 @@ N_STATE = 5
 N_OUT = 5
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _crank_mechanics(p: np.ndarray, th: float, w: float, tau: float, h: float) -> tuple:
     """One semi-implicit Euler step ``h`` [s] of the crank under motor torque ``tau`` [N m].
 
@@ -43,7 +44,7 @@ def _crank_mechanics(p: np.ndarray, th: float, w: float, tau: float, h: float) -
     return th + h * w_new, w_new
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _crank_loop(
     p: np.ndarray,
     steps: int,
