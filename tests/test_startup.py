@@ -69,3 +69,28 @@ def test_help_summary_read_from_source_matches_the_command(name):
     assert command_docstring(name)
     summary = click.Command(name, help=command_docstring(name)).get_short_help_str(60)
     assert summary == command.get_short_help_str(60)
+
+
+def test_batch_fits_and_simulations_compile_nothing():
+    # LPC, ARX and OE fits, a model's simulation and prediction run on numpy and LAPACK: in
+    # a fresh interpreter no numba dispatcher of clpc has compiled (or loaded) a signature
+    code = (
+        "import sys, numpy as np, clpc\n"
+        "rng = np.random.default_rng(0)\n"
+        "u = rng.standard_normal(1500)\n"
+        "y = clpc.simulate_arx(np.array([1.0, -1.5, 0.7]), np.array([0.2, 0.5, 0.1]), u)\n"
+        "y = y + 0.01 * rng.standard_normal(1500)\n"
+        "for est in (clpc.LPC(order=2), clpc.ARX(order=2), clpc.OE(order=2)):\n"
+        "    model = est.fit(u, y)\n"
+        "    model.simulate(u), model.predict(u, y, k=3)\n"
+        "compiled = sorted(\n"
+        "    f'{name}.{attr}' for name, mod in list(sys.modules.items())\n"
+        "    if name.startswith('clpc') for attr, obj in vars(mod).items()\n"
+        "    if hasattr(obj, 'py_func') and getattr(obj, 'signatures', None)\n"
+        ")\n"
+        "print(' '.join(compiled) or 'none')\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.split() == ["none"]
