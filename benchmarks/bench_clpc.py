@@ -5,11 +5,12 @@ system ``A(q) y = B(q) u + e`` with ``A = 1 - 1.5 q^-1 + 0.7 q^-2``, ``B = 0.5 +
 0.1 q^-2`` and equation noise ``e ~ N(0, 0.1^2)``, plus white measurement noise (std 0.02) on
 ``y``. Settings: ``N = 2`` (``parameters_size = 3``), ``W = 201``, ``C = 12``.
 
-Engines (``CLPC(engine=...)``): every rule has one source (:mod:`clpc.core.rules`, kernel
-:mod:`clpc.appraiser.kernel`), run compiled by numba (``compiled``, the default through
-``engine="auto"``) or uncompiled (``python``, for debugging; ~100x slower). Everything is
-measured with ``compiled``; ``python`` gets one batch row at ``T <= --python-max`` (default
-1e4, one repetition) and an exactness check against ``compiled`` on 5e3 samples. The
+Engines: every rule has one source (:mod:`clpc.core.rules`, kernel
+:mod:`clpc.appraiser.kernel`), run compiled by numba (``compiled``, the default) or
+uncompiled (``python``: numba's ``NUMBA_DISABLE_JIT=1``, for debugging; ~100x slower).
+Everything is measured with ``compiled``; ``python`` gets one batch row at
+``T <= --python-max`` (default 1e4, one repetition, in a worker process with
+``NUMBA_DISABLE_JIT=1``) and an exactness check against ``compiled`` on 5e3 samples. The
 compiled kernels are built on their first use in an environment (numba caches them on disk
 under ``src/clpc/**/__pycache__``); the script loads them once at start-up, in this process
 and in a fresh one per package (the time is printed), and every measurement warms up
@@ -35,7 +36,7 @@ reference (D, eigenvalues, theta), ``push``/``step`` vs batch, ``python`` vs ``c
 Baseline (``--baseline-src PATH``): the ``src`` directory of an older checkout of clpc, e.g.
 ``git worktree add /tmp/clpc-baseline <commit>`` then ``--baseline-src
 /tmp/clpc-baseline/src``. Batch at every ``T``, batch with ``cluster_size=1`` and with
-``method='paper'``, and ``step`` are then measured with both packages (``engine="compiled"``)
+``method='paper'``, and ``step`` are then measured with both packages (compiled)
 in fresh subprocess workers (this script with ``--worker``; the baseline's with
 ``PYTHONPATH=PATH``, so that its ``import clpc`` gets the old code, which is checked): one
 worker per package and round runs them all, ``--baseline-rounds`` (3) rounds with the
@@ -69,9 +70,6 @@ Usage::
     python benchmarks/bench_clpc.py --profile --sizes 1e6      # cProfile of run and step
     python benchmarks/bench_clpc.py --sizes 1e4 1e5 1e6
     python benchmarks/bench_clpc.py --huge     # adds a 1e8-sample record streamed from .npy
-
-``--engine`` picks the engine of ``--profile``, ``--only-njobs`` and ``--huge`` (default
-``auto``: the library's default, compiled; ``CLPC_ENGINE`` is honoured as by the library).
 """
 
 from __future__ import annotations
@@ -97,6 +95,11 @@ DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.5, 0.3, 0.1])
 EQ_NOISE, MEAS_NOISE = 0.1, 0.02
 SEED = 20240607
+
+
+def _engine_here() -> str:
+    """``"python"`` when numba's ``NUMBA_DISABLE_JIT`` is set in this process, else compiled."""
+    return "python" if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0") else "compiled"
 
 
 # ====================================================================== data
@@ -236,7 +239,6 @@ def _execute(spec: dict, u, y) -> dict:
         cluster_size=spec.get("cluster", CLUSTER),
         method=spec.get("method", "robust"),
         n_jobs=spec.get("n_jobs", 1),
-        engine=spec.get("engine", "auto"),
     )
     if kind == "batch":
         tr = clpc.CLPC(**kw).run(u, y)
@@ -278,13 +280,7 @@ def worker(spec: dict) -> dict:
     wu = min(n, 5000)
     _execute(spec, u[:wu], y[:wu])
     u_w, y_w = np.asarray(u[:wu], dtype=np.float64), np.asarray(y[:wu], dtype=np.float64)
-    clpc.CLPC(
-        ORDER + 1,
-        WINDOW,
-        CLUSTER,
-        n_jobs=spec.get("n_jobs", 1),
-        engine=spec.get("engine", "auto"),
-    ).run(u_w, y_w)
+    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, n_jobs=spec.get("n_jobs", 1)).run(u_w, y_w)
     can_reset = _reset_peak()
     base = _status_mb().get("VmRSS", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
     base_peak = _peak_rss_mb(can_reset)
@@ -339,7 +335,7 @@ def huge_worker(spec: dict) -> dict:
     raw = getattr(data, "_mmap", None)
     offset = data.offset if hasattr(data, "offset") else 0
     n = data.shape[0]
-    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine=spec.get("engine", "auto"))
+    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER)
     app.push(data[:5000, 0], data[:5000, 1])  # warm-up (not timed)
     app.reset()
     can_reset = _reset_peak()
@@ -376,7 +372,7 @@ def huge_worker(spec: dict) -> dict:
         "max_rss_anon_mb": max_anon,
         "max_rss_file_mb": max_file,
         "drop_pages": spec.get("drop_pages", True),
-        "engine": app.engine,
+        "engine": _engine_here(),
     }
 
 
@@ -399,7 +395,7 @@ def parallel_capacity() -> float:
     return 2.0 * one / two
 
 
-def profile(workdir: Path, n: int, n_step: int, engine: str = "auto", top: int = 18) -> None:
+def profile(workdir: Path, n: int, n_step: int, top: int = 18) -> None:
     """cProfile of CLPC().run on n samples and of step on n_step samples (tottime order)."""
     import cProfile
     import io
@@ -409,16 +405,16 @@ def profile(workdir: Path, n: int, n_step: int, engine: str = "auto", top: int =
 
     u, y = load(workdir, n)
     u_s, y_s = u[:n_step].tolist(), y[:n_step].tolist()
-    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine=engine)
+    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER)
     app.run(u[:5000], y[:5000])  # warm-up (compiles the kernel if numba's cache is cold)
-    _steps(u_s[:2000], y_s[:2000], engine)
-    name = f"engine={app.engine!r}"
+    _steps(u_s[:2000], y_s[:2000])
+    name = _engine_here()
     for title, stmt in (
         (
             f"CLPC({name}).run, T={fmt_n(n)}",
-            lambda: clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine=engine).run(u, y),
+            lambda: clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).run(u, y),
         ),
-        (f"step x {fmt_n(n_step)} (Python floats, {name})", lambda: _steps(u_s, y_s, engine)),
+        (f"step x {fmt_n(n_step)} (Python floats, {name})", lambda: _steps(u_s, y_s)),
     ):
         prof = cProfile.Profile()
         prof.enable()
@@ -433,10 +429,10 @@ def profile(workdir: Path, n: int, n_step: int, engine: str = "auto", top: int =
         print(f"```\n(total {st.total_tt:.2f} s under the profiler)\n")
 
 
-def _steps(u: list[float], y: list[float], engine: str = "auto") -> None:
+def _steps(u: list[float], y: list[float]) -> None:
     import clpc
 
-    step = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine=engine).step
+    step = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).step
     for u_k, y_k in zip(u, y, strict=True):
         step(u_k, y_k)
 
@@ -469,12 +465,14 @@ def run_worker(spec: dict, pythonpath: str | None = None, flag: str = "--worker"
     ``pythonpath``: the ``src`` directory of another clpc checkout; the worker then runs
     with ``PYTHONPATH`` set to it alone, so its ``import clpc`` gets that code (it comes
     before the installed, editable package on ``sys.path``); checked from the worker's
-    answer.
+    answer. ``spec["engine"] == "python"``: the worker runs with ``NUMBA_DISABLE_JIT=1``.
     """
     cmd = [sys.executable, os.path.abspath(__file__), flag, json.dumps(spec)]
-    env = None
+    env = dict(os.environ)
     if pythonpath is not None:
-        env = {**os.environ, "PYTHONPATH": pythonpath}
+        env["PYTHONPATH"] = pythonpath
+    if spec.get("engine") == "python":
+        env["NUMBA_DISABLE_JIT"] = "1"
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     if proc.returncode != 0:
         raise RuntimeError(f"worker {spec} failed:\n{proc.stderr}")
@@ -490,14 +488,14 @@ def run_worker(spec: dict, pythonpath: str | None = None, flag: str = "--worker"
 def prime_worker(spec: dict) -> dict:
     """First use of the clpc on ``sys.path`` in this process: loads (or compiles) its kernels.
 
-    Runs ``run``, ``push`` and ``step`` with ``spec["engine"]`` once, so that a later worker
+    Runs ``run``, ``push`` and ``step`` once, so that a later worker
     never compiles (numba caches on disk); returns the time it took and where clpc is.
     """
     import clpc
 
     u, y = load(Path(spec["workdir"]), 3000)
     t0 = time.perf_counter()
-    kw = {"method": spec.get("method", "robust"), "engine": spec["engine"]}
+    kw = {"method": spec.get("method", "robust")}
     clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw).run(u, y)
     clpc.CLPC(ORDER + 1, WINDOW, 1, **kw).run(u, y)
     app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw)
@@ -508,7 +506,7 @@ def prime_worker(spec: dict) -> dict:
         "time": time.perf_counter() - t0,
         "clpc_file": clpc.__file__,
         "version": getattr(clpc, "__version__", "?"),
-        "engine": app.engine,
+        "engine": _engine_here(),
     }
 
 
@@ -519,7 +517,7 @@ def dump_worker(spec: dict) -> dict:
     u, y = load(Path(spec["workdir"]), spec["n"])
     arrays = {}
     for method in ("robust", "paper"):
-        tr = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method, engine=spec["engine"]).run(u, y)
+        tr = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method).run(u, y)
         for key in ("theta", "theta_estimate", "D", "accepted"):
             arrays[f"{method}_{key}"] = np.asarray(getattr(tr, key))
     np.savez(spec["out"], **arrays)
@@ -591,8 +589,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--profile",
         action="store_true",
-        help="only cProfile CLPC().run at T = max of --sizes (capped at 1e6) and step, "
-        "with --engine (default: the library's default engine)",
+        help="only cProfile CLPC().run at T = max of --sizes (capped at 1e6) and step "
+        "(uncompiled with NUMBA_DISABLE_JIT=1 in the environment)",
     )
     ap.add_argument(
         "--only-njobs",
@@ -603,8 +601,8 @@ def main(argv: list[str] | None = None) -> int:
         "--python-max",
         type=float,
         default=1e4,
-        help="the uncompiled engine='python' (debugging only, very slow) gets a batch row at "
-        "the sizes T <= this (default 1e4; 0: none)",
+        help="the uncompiled kernel (NUMBA_DISABLE_JIT=1, debugging only, very slow) gets a "
+        "batch row at the sizes T <= this (default 1e4; 0: none)",
     )
     ap.add_argument(
         "--baseline-src",
@@ -620,13 +618,6 @@ def main(argv: list[str] | None = None) -> int:
         default=3,
         help="rounds of the new vs baseline measurements, each a worker per package, their "
         "order alternating; the best of each package is kept (default 3)",
-    )
-    ap.add_argument(
-        "--engine",
-        choices=["auto", "compiled", "python"],
-        default="auto",
-        help="engine of --profile, --only-njobs and --huge (default auto: the library's "
-        "default, compiled)",
     )
     ap.add_argument("--workdir", default=None, help="where the data files go (default: temp)")
     ap.add_argument("--keep-data", action="store_true", help="keep the data files (--workdir)")
@@ -676,12 +667,13 @@ def main(argv: list[str] | None = None) -> int:
     t_rep = 0.5 if args.quick else 3.0  # repeat the n_jobs/method runs for at least this long
     n_data = max([*sizes, step_n, t_c1, t_check])
 
-    # the compiled engine is measured throughout; engine="python" runs the same source
-    # uncompiled (debugging only, ~100x slower): one batch row at T <= --python-max
+    # the compiled kernel is measured throughout; "python" runs the same source uncompiled
+    # (NUMBA_DISABLE_JIT=1 in a worker; debugging only, ~100x slower): one batch row at
+    # T <= --python-max
     engines = ["compiled"]
-    default_engine = clpc.CLPC().engine  # what engine="auto" gives (CLPC_ENGINE honoured)
+    default_engine = "compiled"
     main_engine = engines[0]
-    sel_engine = clpc.CLPC(engine=args.engine).engine  # --profile / --only-njobs / --huge
+    sel_engine = _engine_here()  # --profile / --only-njobs / --huge: this process's
 
     def eng_name(e: str) -> str:
         return f"{e} (default)" if e == default_engine else e
@@ -711,12 +703,11 @@ def main(argv: list[str] | None = None) -> int:
         "method='robust' unless stated"
     )
     print(
-        f"engines: compiled; python (uncompiled, batch at T <= {fmt_n(python_max)} only); "
-        f"engine='auto' gives {default_engine!r}"
-        + (f" (CLPC_ENGINE={os.environ['CLPC_ENGINE']})" if os.environ.get("CLPC_ENGINE") else "")
+        f"engines: compiled; python (NUMBA_DISABLE_JIT=1, uncompiled, batch at "
+        f"T <= {fmt_n(python_max)} only)"
     )
     if baseline is not None:
-        print(f"baseline: {baseline} ({_git_state(Path(baseline).parent)}), engine='compiled'")
+        print(f"baseline: {baseline} ({_git_state(Path(baseline).parent)}), compiled")
     gen0 = time.perf_counter()
     generate(workdir / "u.bin", workdir / "y.bin", n_data)
     print(f"(generated {fmt_n(n_data)} samples in {time.perf_counter() - gen0:.1f} s)")
@@ -725,7 +716,7 @@ def main(argv: list[str] | None = None) -> int:
     # no worker ever compiles (each also warms up before timing)
     u0, y0 = load(workdir, 5000)
     c0 = time.perf_counter()
-    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="compiled").run(u0, y0)
+    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).run(u0, y0)
     c_here = time.perf_counter() - c0
     prime = {"workdir": str(workdir), "engine": "compiled"}
     c_new = run_worker(prime, flag="--prime-worker")["time"]
@@ -752,7 +743,8 @@ def main(argv: list[str] | None = None) -> int:
             # contention by other jobs only ever slows a run down: keep the best of three
             spec.setdefault("min_reps", 3)
         # small runs in this process (no interpreter start-up); large ones in a fresh one
-        res = worker(spec) if n <= 1e5 else run_worker(spec)
+        in_here = n <= 1e5 and kw.get("engine", main_engine) == _engine_here()
+        res = worker(spec) if in_here else run_worker(spec)
         res["n"] = n
         return res
 
@@ -770,7 +762,7 @@ def main(argv: list[str] | None = None) -> int:
         return f"{mem(res) - res['trace_mb']:.{digits}f}"
 
     if args.profile:
-        profile(workdir, t_cmp, step_n, sel_engine)
+        profile(workdir, t_cmp, step_n)
         if args.workdir is None:
             shutil.rmtree(workdir, ignore_errors=True)
         return 0
@@ -1088,7 +1080,7 @@ def main(argv: list[str] | None = None) -> int:
     for eng in engines:
 
         def make(method: str = "robust", eng: str = eng) -> clpc.CLPC:
-            return clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method, engine=eng)
+            return clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method)
 
         tr = paper[eng] = make("paper").run(u, y)
         assert len(tr) == th_ref.shape[0], (len(tr), th_ref.shape)
@@ -1149,17 +1141,17 @@ def main(argv: list[str] | None = None) -> int:
 
     if python_max > 0:
         n_py = min(t_check, 5000)
+        out = workdir / "python-trace.npz"
+        spec_py = {"workdir": str(workdir), "n": n_py, "engine": "python", "out": str(out)}
+        run_worker(spec_py, flag="--dump-worker")  # NUMBA_DISABLE_JIT=1 in the worker
+        with np.load(out) as z:
+            slow = {k: z[k] for k in z.files}
         for method in ("robust", "paper"):
-            kw_py = {"method": method}
-            a = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="python", **kw_py).run(
-                u[:n_py], y[:n_py]
-            )
-            b = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, engine="compiled", **kw_py).run(
-                u[:n_py], y[:n_py]
-            )
+            a = {k[len(method) + 1 :]: v for k, v in slow.items() if k.startswith(method + "_")}
+            b = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method).run(u[:n_py], y[:n_py])
             print(
-                f"- python vs compiled engine ({method} batch, T={fmt_n(n_py)}): "
-                f"{agreement(arrays(a), arrays(b))}"
+                f"- python (NUMBA_DISABLE_JIT=1) vs compiled ({method} batch, "
+                f"T={fmt_n(n_py)}): {agreement(a, arrays(b))}"
             )
     if baseline is not None:
         out = workdir / "baseline-trace.npz"

@@ -166,16 +166,6 @@ PUBLIC = (
     "clpc.report",
 )
 
-#: library modules the plants still import although they are not public, and why (each for
-#: the modules under one prefix only)
-TOLERATED = {
-    "clpc.core.jit": (
-        "clpc_paper.plants.",
-        "the servo's compiled loops are written with the engine's kernel/compiled (issue 24 "
-        "point 3 replaces both by plain numba.njit)",
-    ),
-}
-
 
 def _sites(source: str, name: str, package: bool) -> list[tuple[str, tuple[str, ...], str]]:
     """Every import in ``source``: (absolute module, names taken from it, enclosing function).
@@ -219,20 +209,13 @@ def _public_names(module: str) -> set[str]:
     return set(getattr(importlib.import_module(module), "__all__", ()))
 
 
-def _tolerated(name: str, module: str) -> bool:
-    rule = TOLERATED.get(module)
-    return rule is not None and name.startswith(rule[0])
-
-
 def _private_uses(name: str, source: str, package: bool = False) -> list[str]:
     """Imports of the library by clpc_paper module ``name`` that are not public API."""
     bad = []
     for mod, names, _ in _sites(source, name, package):
-        if _top(mod) != "clpc" or _tolerated(name, mod):
+        if _top(mod) != "clpc":
             continue
-        kept = tuple(n for n in names if not _tolerated(name, f"{mod}.{n}"))  # from a import b
-        if names and not kept:
-            continue
+        kept = names
         if mod not in PUBLIC:
             bad.append(f"{name} imports {mod}")
             continue
@@ -280,19 +263,6 @@ def test_the_paper_imports_public_api_only():
         for use in _private_uses(name, path.read_text(encoding="utf-8"), path.name == "__init__.py")
     ]
     assert bad == []
-
-
-def test_the_tolerated_private_imports_are_still_used():
-    # an exception nobody needs any more goes
-    used = {
-        target
-        for name, path in _paper_modules().items()
-        for mod, names, _ in _sites(
-            path.read_text(encoding="utf-8"), name, path.name == "__init__.py"
-        )
-        for target in (mod, *(f"{mod}.{n}" for n in names))
-    }
-    assert set(TOLERATED) <= used
 
 
 def test_the_plants_do_not_import_the_experiment():
@@ -344,13 +314,9 @@ def test_the_paper_checks_see_a_violation():
     assert _private_uses(paper, "from clpc import _moved\n")
     assert _private_uses(paper, "from clpc import core\n")
     assert _private_uses(paper, "from clpc.appraiser import convergence\n")
-    assert _private_uses(paper, "from clpc.core.jit import kernel\n")  # tolerated in plants only
-    assert _private_uses(paper, "from clpc.core import jit\n")
+    assert _private_uses(paper, "from clpc.core.polynomials import monic\n")
     plant = "clpc_paper.plants.servo_loop"
-    assert (
-        _private_uses(plant, "from clpc.core import jit\nfrom clpc.core.jit import kernel\n") == []
-    )
-    assert _private_uses(plant, "from clpc.core import jit, checks\n")
+    assert _private_uses(plant, "from clpc.core import checks\n")
     assert _private_uses(paper, "from ..x import y\n") == []
     assert _private_uses(paper, "from clpc import LPC, plotting\nimport clpc\n") == []
     assert _private_uses(paper, "from clpc.plotting import plot_multimodel\n") == []

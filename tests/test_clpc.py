@@ -1,7 +1,7 @@
 """The CLPC appraiser: semantics, streaming == batch, persistence, exactness, tracking.
 
-The tests run on the default (compiled) engine, selected through ``CLPC_ENGINE`` as a user
-would; ``tests/test_window_kernel.py`` runs the uncompiled engine against the reference.
+The tests run the compiled kernel (or, with ``NUMBA_DISABLE_JIT=1``, the same functions
+uncompiled); ``tests/test_window_kernel.py`` compares the two against a reference.
 """
 
 from __future__ import annotations
@@ -20,13 +20,6 @@ from clpc import CLPC, DataError, Trace
 
 DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.2, 0.5, 0.1])
-
-
-@pytest.fixture(autouse=True, params=["compiled"])
-def engine(request, monkeypatch):
-    monkeypatch.setenv("CLPC_ENGINE", request.param)
-    assert CLPC().engine == request.param
-    return request.param
 
 
 def record(n: int, seed: int = 0, noise: float = 0.0, offset: float = 0.0):

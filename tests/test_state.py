@@ -75,6 +75,18 @@ def test_untampered_state_continues_identically(saved):
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
 
 
+def test_state_saved_with_an_engine_setting_still_restores(saved):
+    # states written while CLPC had engine="auto"|"compiled"|"python" (now NUMBA_DISABLE_JIT)
+    from clpc.appraiser.state import digest
+
+    state, u, y = copy.deepcopy(saved[0]), saved[1], saved[2]
+    state["config"]["engine"] = "compiled"
+    state["digest"] = digest(state)
+    resumed = CLPC.from_state_dict(state).push(u[2000:], y[2000:])
+    whole = CLPC(3, 201, 12).run(u, y)
+    np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
+
+
 @pytest.mark.parametrize(
     "text", ["[]", "3", '"x"', "{" * 100 + "}" * 100, '{"a": 1' + "0" * 500 + "}"]
 )

@@ -1,19 +1,26 @@
-"""The CLPC engine against an independent per-window SVD reference; its eigen-solver.
+"""The CLPC kernel against an independent per-window SVD reference; its eigen-solver.
 
 The reference (``tests/lpc_reference.py``) builds each window's lag matrix, centers it and
-takes its SVD, with array formulas for the rules; the engine merges block statistics and
-runs :mod:`clpc.core.rules` in compiled loops. Both engines of the one source (compiled and
-plain Python) are checked against it.
+takes its SVD, with array formulas for the rules; the kernel merges block statistics and
+runs :mod:`clpc.core.rules` in compiled loops. The module runs as it is (compiled) and, in
+CI, once more with ``NUMBA_DISABLE_JIT=1`` (the same functions as plain Python);
+:func:`test_uncompiled_kernels_equal_the_compiled_ones` compares the two in one run.
 """
 
 from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import types
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import clpc
 from clpc import CLPC, DataError, Trace
-from clpc.core import jit as engine_module
+from clpc.appraiser import kernel
 from clpc.core.small_eigh import sym_eig
 from lpc_reference import reference_clpc
 
@@ -64,7 +71,7 @@ def test_small_eigh_reports_non_finite_input():
     assert not sym_eig(a, np.empty(4), np.empty((4, 4)), np.empty(4), True)
 
 
-# ---------------------------------------------------------------- engine parity
+# ---------------------------------------------------------------- kernel parity
 def _record(n, seed, n_in=1, n_out=1, offset=0.0):
     rng = np.random.default_rng(seed)
     u = rng.standard_normal((n, n_in))
@@ -117,28 +124,92 @@ PARITY_CASES = [
 
 
 @pytest.mark.parametrize(("kwargs", "n_in", "n_out"), PARITY_CASES)
-def test_engine_equals_per_window_svd_reference(kwargs, n_in, n_out):
+def test_kernel_equals_per_window_svd_reference(kwargs, n_in, n_out):
     u, y = _record(3000, seed=3, n_in=n_in, n_out=n_out, offset=1e3)
     settings = {"parameters_size": 3, "window_size": 201, "cluster_size": 12, **kwargs}
-    appraiser = CLPC(**settings, engine="compiled")
+    appraiser = CLPC(**settings)
     _compare(appraiser.run(u, y), reference_clpc(u, y, appraiser))
 
 
-@pytest.mark.parametrize(("kwargs", "n_in", "n_out"), PARITY_CASES[::3])
-def test_python_engine_runs_the_same_source(kwargs, n_in, n_out):
-    # the uncompiled engine: the very same functions, run by the interpreter (coverage)
-    u, y = _record(700, seed=4, n_in=n_in, n_out=n_out, offset=1e3)
-    settings = {"parameters_size": 3, "window_size": 101, "cluster_size": 12, **kwargs}
-    appraiser = CLPC(**settings, engine="python")
-    slow = appraiser.run(u, y)
-    _compare(slow, reference_clpc(u, y, appraiser))
-    fast = CLPC(**settings, engine="compiled").run(u, y)
-    for key in ("theta", "eigenvalues", "c", "J", "accepted"):
-        np.testing.assert_allclose(slow.arrays[key], fast.arrays[key], rtol=1e-13, atol=0)
+UNCOMPILED_CASES = PARITY_CASES[::3]
+UNCOMPILED_KEYS = ("theta", "eigenvalues", "c", "J", "accepted", "den", "stable")
+
+
+def kernel_outputs(inputs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """What the kernels compute on ``inputs``: CLPC traces, a blended free run, monic forms.
+
+    Run in this process (compiled) and by :func:`test_uncompiled_kernels_equal_the_compiled_ones`
+    in a child with ``NUMBA_DISABLE_JIT=1`` (uncompiled).
+    """
+    from clpc.core.polynomials import monic_many, stable_many
+    from clpc.multimodel.kernels import run_blend, run_varying
+
+    out = {}
+    for i, (kwargs, _, _) in enumerate(UNCOMPILED_CASES):
+        settings = {"parameters_size": 3, "window_size": 101, "cluster_size": 12, **kwargs}
+        trace = CLPC(**settings).run(inputs[f"clpc_u{i}"], inputs[f"clpc_y{i}"])
+        out.update({f"clpc{i}_{key}": trace.arrays[key] for key in UNCOMPILED_KEYS})
+    models = (inputs["den"], inputs["num"], inputs["icpt"])
+    u, y0 = inputs["u"], inputs["y0"]
+    sched = (0, 0, 1)  # scheduled on y(n - 1)
+    out["blend"] = run_blend(models, inputs["centres"], inputs["widths"], sched, u, y0.copy(), 2)
+    steps = np.arange(u.shape[0]) % models[0].shape[0]  # the models in turn
+    picked = (models[0][steps], models[1][steps], models[2][steps])
+    out["varying"] = run_varying(picked, u, y0.copy(), 2)
+    out["den"], out["num"] = monic_many(inputs["theta"], 2, 2, 0, 1, False)
+    out["stable"] = stable_many(out["den"])
+    return out
+
+
+def _kernel_inputs(rng: np.random.Generator) -> dict[str, np.ndarray]:
+    inputs = {}
+    for i, (_, n_in, n_out) in enumerate(UNCOMPILED_CASES):
+        inputs[f"clpc_u{i}"], inputs[f"clpc_y{i}"] = _record(
+            700, seed=4, n_in=n_in, n_out=n_out, offset=1e3
+        )
+    m = 3
+    poles = rng.uniform(0.2, 0.9, (m, 2))
+    inputs["den"] = np.stack([np.poly(p) for p in poles])
+    inputs["num"] = rng.standard_normal((m, 1, 3))
+    inputs["icpt"] = rng.standard_normal(m)
+    inputs["centres"] = np.array([-1.0, 0.0, 1.0])
+    inputs["widths"] = np.array([0.5, 0.7, 0.5])
+    inputs["u"] = rng.standard_normal((400, 1))
+    inputs["y0"] = np.r_[0.1, -0.2, np.zeros(398)]
+    inputs["theta"] = rng.standard_normal((50, 1, 6))
+    return inputs
+
+
+@pytest.mark.skipif(
+    os.environ.get("NUMBA_DISABLE_JIT", "0") != "0", reason="this process is uncompiled too"
+)
+def test_uncompiled_kernels_equal_the_compiled_ones(tmp_path):
+    # the same functions run by the interpreter (NUMBA_DISABLE_JIT=1, a child process) and
+    # compiled by numba (this process): the same numbers
+    inputs = _kernel_inputs(np.random.default_rng(8))
+    np.savez(tmp_path / "inputs.npz", **inputs)
+    child = (
+        "import sys, types, numpy as np\n"
+        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+        "from clpc.appraiser import kernel\n"
+        "assert isinstance(kernel.solve_windows, types.FunctionType), 'compiled'\n"
+        "from test_window_kernel import kernel_outputs\n"
+        "inputs = dict(np.load(sys.argv[1]))\n"
+        "np.savez(sys.argv[2], **kernel_outputs(inputs))\n"
+    )
+    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    cmd = [sys.executable, "-c", child, str(tmp_path / "inputs.npz"), str(tmp_path / "out.npz")]
+    subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
+    slow = dict(np.load(tmp_path / "out.npz"))
+    assert not isinstance(kernel.solve_windows, types.FunctionType)  # compiled here
+    fast = kernel_outputs(inputs)
+    assert sorted(slow) == sorted(fast)
+    for key, value in fast.items():
+        np.testing.assert_allclose(slow[key], value, rtol=1e-13, atol=0, err_msg=key)
 
 
 @pytest.mark.parametrize("kind", ["ramp", "constant", "zeros"])
-def test_engine_agrees_with_reference_on_poorly_excited_and_degenerate_windows(kind):
+def test_kernel_agrees_with_reference_on_poorly_excited_and_degenerate_windows(kind):
     rng = np.random.default_rng(5)
     u = rng.standard_normal(2000)
     if kind == "ramp":
@@ -151,7 +222,7 @@ def test_engine_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
         2000
     )
     for gate in (False, True):
-        appraiser = CLPC(3, 101, 12, gate=gate, engine="compiled")
+        appraiser = CLPC(3, 101, 12, gate=gate)
         fast = appraiser.run(u, y)
         ref = reference_clpc(u, y, appraiser)
         np.testing.assert_array_equal(fast.degenerate, ref["degenerate"][:, 0])
@@ -166,10 +237,10 @@ def test_engine_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
 def test_compiled_stream_and_step_are_bit_identical_to_run():
     u, y = _record(2000, seed=9, offset=1e4)
     u, y = u[:, 0], y[:, 0]
-    batch = CLPC(3, 201, 12, engine="compiled").run(u, y)
-    a = CLPC(3, 201, 12, engine="compiled")
+    batch = CLPC(3, 201, 12).run(u, y)
+    a = CLPC(3, 201, 12)
     pushed = Trace.concat([a.push(u[i : i + 97], y[i : i + 97]) for i in range(0, 2000, 97)])
-    b = CLPC(3, 201, 12, engine="compiled")
+    b = CLPC(3, 201, 12)
     # python and numpy scalars take the light path, arrays the general one
     feeds = [float, np.float64, lambda v: np.array([v])]
     stepped = [b.step(feeds[k % 3](u[k]), feeds[k % 3](y[k])) for k in range(2000)]
@@ -197,22 +268,3 @@ def test_step_rejects_non_finite_scalars_with_the_sample_index():
     with pytest.raises(DataError, match="y channel 0 is not finite at sample 5"):
         a.step(1.0, float("nan"))
     assert a.n_samples == 5  # the bad sample was not taken
-
-
-def test_engine_choice_and_errors(monkeypatch):
-    assert CLPC(engine="python").engine == "python"
-    monkeypatch.setenv("CLPC_ENGINE", "python")
-    assert CLPC().engine == "python"
-    assert CLPC(engine="compiled").engine == "compiled"  # an explicit choice wins
-    monkeypatch.setenv("CLPC_ENGINE", "fast")
-    with pytest.raises(ValueError, match="CLPC_ENGINE"):
-        CLPC()
-    with pytest.raises(ValueError, match="engine must be"):
-        CLPC(engine="gpu")
-    with pytest.raises(ValueError, match="engine must be"):
-        CLPC(engine="numpy")  # the numpy engine is gone: one source, two ways to run it
-    monkeypatch.setattr(engine_module, "numba_available", lambda: False)
-    with pytest.raises(ValueError, match="needs numba"):
-        CLPC(engine="compiled")
-    monkeypatch.delenv("CLPC_ENGINE")
-    assert CLPC().engine == "python"  # auto without numba

@@ -1,9 +1,8 @@
-"""The appraiser's engine: the kernel's inputs from the settings, and who runs the kernel.
+"""The appraiser's calls into its kernel, and the kernel's inputs from the settings.
 
-``"compiled"`` runs :mod:`clpc.appraiser.kernel` through numba (the default),
-``"python"`` runs the very same functions uncompiled (slow: for debugging and coverage).
-``"auto"`` is ``"compiled"`` unless the environment variable ``CLPC_ENGINE`` says
-otherwise.
+:mod:`clpc.appraiser.kernel` is compiled by numba (``numba.njit(cache=True)``); with the
+environment variable ``NUMBA_DISABLE_JIT=1`` numba leaves it uncompiled and the same
+functions run as plain Python (slow: for debugging and coverage).
 """
 
 from __future__ import annotations
@@ -13,12 +12,11 @@ from typing import Any
 import numpy as np
 
 from clpc.appraiser import kernel
-from clpc.core.jit import ENGINES, compiled, resolve_engine
 from clpc.core.rules import RobustRule, SolveSettings, solve_settings, transform_mode
 from clpc.lpc.solve import fixed_transform
 from clpc.model.structure import Structure
 
-__all__ = ["ENGINES", "Engine", "resolve_engine", "window_plan"]
+__all__ = ["output", "settings_for", "solve", "update", "window_plan"]
 
 
 def window_plan(
@@ -85,66 +83,56 @@ def settings_for(
     return solve_settings(rule, name == "robust", mode, na + 1, n_channels)
 
 
-class Engine:
-    """Runs the kernel compiled or as plain Python.
+def update(
+    samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: Any, state: Any
+) -> tuple[kernel.Solved, kernel.FsmOutput]:
+    """Solve ``windows`` and run the FSM output over them in one kernel call.
 
     Parameters
     ----------
-    name : {"compiled", "python"}
+    samples : (ndarray, int)
+        The buffered samples, shape (n, channels), and the absolute lag row of the first.
+    windows : (int, int)
+        ``(j0, count)``: updates ``j0 .. j0 + count - 1``.
+    setup : KernelSetup
+        The record's :class:`clpc.appraiser.updates.KernelSetup` (its ``plain`` settings go
+        to :func:`clpc.appraiser.kernel.update_windows`).
+    state : FsmState
+        The carried :class:`clpc.appraiser.kernel.FsmState` (updated in place).
+
+    Returns
+    -------
+    solved : Solved
+    output : FsmOutput
     """
+    solved = _solved(windows[1], setup.plan)
+    out = _fsm_output(solved, setup.fsm, setup.n_inputs)
+    kernel.update_windows(
+        samples[0], samples[1], windows, setup.plain, tuple(state), (tuple(solved), tuple(out))
+    )
+    return solved, out
 
-    def __init__(self, name: str) -> None:
-        self.name = name
-        if name == "compiled":
-            self._solve = compiled(kernel.solve_windows)
-            self._output = compiled(kernel.fsm_output)
-            self._update = compiled(kernel.update_windows)
-        else:
-            self._solve = kernel.solve_windows
-            self._output = kernel.fsm_output
-            self._update = kernel.update_windows
 
-    def update(
-        self, samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: Any, state: Any
-    ) -> tuple[kernel.Solved, kernel.FsmOutput]:
-        """Solve ``windows`` and run the FSM output over them in one kernel call.
+def solve(
+    samples: np.ndarray,
+    first_row: int,
+    windows: tuple[int, int],
+    plan: kernel.WindowPlan,
+    settings: SolveSettings,
+) -> kernel.Solved:
+    """Solve ``windows = (j0, count)`` (see :func:`clpc.appraiser.kernel.solve_windows`)."""
+    out = _solved(windows[1], plan)
+    kernel.solve_windows(samples, first_row, windows, plan, settings, out)
+    return out
 
-        ``setup`` is the record's :class:`clpc.appraiser.updates.KernelSetup` (its
-        ``plain`` settings go to :func:`clpc.appraiser.kernel.update_windows`), ``state``
-        the carried :class:`clpc.appraiser.kernel.FsmState` (updated in place).
-        """
-        solved = _solved(windows[1], setup.plan)
-        out = _fsm_output(solved, setup.fsm, setup.n_inputs)
-        self._update(
-            samples[0],
-            samples[1],
-            windows,
-            setup.plain,
-            tuple(state),
-            (tuple(solved), tuple(out)),
-        )
-        return solved, out
 
-    def solve(
-        self,
-        samples: np.ndarray,
-        first_row: int,
-        windows: tuple[int, int],
-        plan: kernel.WindowPlan,
-        settings: SolveSettings,
-    ) -> kernel.Solved:
-        """Solve ``windows = (j0, count)`` (see :func:`clpc.appraiser.kernel.solve_windows`)."""
-        out = _solved(windows[1], plan)
-        self._solve(samples, first_row, windows, plan, settings, out)
-        return out
-
-    def output(
-        self, solved: kernel.Solved, fs: kernel.FsmSettings, state: kernel.FsmState, n_inputs: int
-    ) -> kernel.FsmOutput:
-        """The FSM output of ``solved`` (``state`` is updated in place)."""
-        out = _fsm_output(solved, fs, n_inputs)
-        self._output(solved, fs, state, out)
-        return out
+def output(
+    solved: kernel.Solved, fs: kernel.FsmSettings, state: kernel.FsmState, n_inputs: int
+) -> kernel.FsmOutput:
+    """The FSM output of ``solved`` (``state`` is updated in place)."""
+    out = _fsm_output(solved, fs, n_inputs)
+    kernel.fsm_output(solved, fs, state, out)
+    return out
 
 
 def _solved(count: int, plan: kernel.WindowPlan) -> kernel.Solved:

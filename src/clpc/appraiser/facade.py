@@ -43,7 +43,6 @@ from clpc.appraiser import fsm
 from clpc.appraiser import state as state_io
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator, decimation_factor
-from clpc.appraiser.engine import resolve_engine
 from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite, check_noise_cov
 from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.trace import Trace
@@ -118,11 +117,13 @@ class CLPC:
         Threads for the batched solves (windows are independent).
     chunk_samples : int
         Samples processed at a time by :meth:`push` (bounds memory).
-    engine : {"auto", "compiled", "python"}
-        ``"compiled"``: the numba-compiled kernel (:mod:`clpc.appraiser.kernel`, the
-        default); ``"python"``: the same functions run uncompiled (slow; for debugging and
-        coverage). ``"auto"`` (default) is ``"compiled"`` unless the environment variable
-        ``CLPC_ENGINE`` names another engine.
+
+    Notes
+    -----
+    The windows are solved by a numba-compiled kernel (:mod:`clpc.appraiser.kernel`,
+    compiled on first use and cached on disk); with the environment variable
+    ``NUMBA_DISABLE_JIT=1`` the same functions run uncompiled (slow; for debugging and
+    coverage).
     """
 
     def __init__(
@@ -152,7 +153,6 @@ class CLPC:
         data_sample_time: float | None = None,
         n_jobs: int = 1,
         chunk_samples: int = 65536,
-        engine: str = "auto",
     ) -> None:
         if cluster_size is not None and data_cluster_dimension is not None:
             if cluster_size != data_cluster_dimension:
@@ -202,8 +202,6 @@ class CLPC:
         self.data_sample_time = None if data_dt is None else _seconds(data_dt, "dt")
         self.n_jobs = check_int(n_jobs, "n_jobs", 1)
         self.chunk_samples = check_int(chunk_samples, "chunk_samples", 1024)
-        self._engine_request = engine
-        self.engine = resolve_engine(engine)  # the one in use: "compiled" or "python"
         self._pool: ThreadPoolExecutor | None = None
         self.reset()
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from clpc.appraiser import kernel
 from clpc.appraiser.buffer import SampleBuffer
-from clpc.appraiser.engine import Engine, settings_for, window_plan
+from clpc.appraiser.engine import settings_for, window_plan
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.updates import KernelSetup, TraceLabels, empty_arrays, solve_updates
 from clpc.core.rules import trust_rows
@@ -100,7 +100,7 @@ def init_channels(a: Any, n_in: int, n_out: int, names: Any = None) -> None:
 
 # ------------------------------------------------------------------ updates
 def kernel_setup(a: Any) -> KernelSetup:
-    """The kernel's plan, settings and engine (fixed per record)."""
+    """The kernel's plan and settings (fixed per record)."""
     if a._setup is None:
         assert a._n_in is not None and a._n_out is not None
         s = a.structure
@@ -109,7 +109,6 @@ def kernel_setup(a: Any) -> KernelSetup:
         sizes = (a.window_size, a.cluster_size, min_rows(a))
         plan, n_channels = window_plan(s, (a._n_in, a._n_out, miso), sizes, cov)
         a._setup = KernelSetup(
-            engine=Engine(a.engine),
             plan=plan,
             settings=settings_for((a.method, a.scaling), a.rule, cov, s.na, n_channels),
             fsm=kernel.FsmSettings(

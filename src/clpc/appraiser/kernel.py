@@ -1,7 +1,7 @@
-r"""The CLPC engine: block statistics, exact window merge, LPC solve and FSM output.
+r"""The CLPC kernel: block statistics, exact window merge, LPC solve and FSM output.
 
-One source for both engines (:mod:`clpc.core.jit`): ``"compiled"`` runs these loops through
-numba, ``"python"`` runs them as they are (slow; for debugging and coverage). The rules of
+Plain ``numba.njit(cache=True)`` functions; with ``NUMBA_DISABLE_JIT=1`` numba leaves them
+uncompiled and they run as plain Python (slow; for debugging and coverage). The rules of
 the solution are :mod:`clpc.core.rules`, the eigen-solver :mod:`clpc.core.small_eigh`, the
 monic form and the stability test :mod:`clpc.core.polynomials`: nothing here restates them.
 
@@ -30,9 +30,9 @@ from __future__ import annotations
 import math
 from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 
-from clpc.core.jit import kernel
 from clpc.core.polynomials import monic, schur_stable
 from clpc.core.rules import (
     NO_TRANSFORM,
@@ -137,7 +137,7 @@ class Work(NamedTuple):
     scales: np.ndarray  #: (p,)
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def new_work(p: int) -> Work:
     """Work space for problems of size ``p``."""
     return Work(
@@ -152,7 +152,7 @@ def new_work(p: int) -> Work:
     )
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def piece_stats(
     samples: np.ndarray,
     chan: np.ndarray,
@@ -191,7 +191,7 @@ def piece_stats(
             scat[b, a] = scat[a, b]
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, int]) -> float:
     """The smallest nonzero change of one channel over the newest samples of rows ``rows``.
 
@@ -207,7 +207,7 @@ def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, i
     return best
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def merge(
     blocks: tuple[np.ndarray, np.ndarray, int, int, int],
     tail: tuple[int, np.ndarray, np.ndarray],
@@ -249,7 +249,7 @@ def merge(
     return float(total)
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_one(
     scat: np.ndarray,
     mean: np.ndarray,
@@ -297,7 +297,7 @@ def solve_one(
     )
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_windows(
     samples: np.ndarray,
     first_row: int,
@@ -384,7 +384,7 @@ def solve_windows(
             out.excited[w, eq] = is_excited(scat, n_w, step, s.n_out_cols)
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput) -> None:
     """The FSM output of solved windows, in time order.
 
@@ -444,7 +444,7 @@ def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput)
                 out.stable[w, e] = False
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def update_windows(
     samples: np.ndarray,
     first_row: int,

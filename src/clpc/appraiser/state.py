@@ -69,7 +69,6 @@ def config_of(a: Any) -> dict[str, Any]:
         "dt": a.data_sample_time,
         "n_jobs": a.n_jobs,
         "chunk_samples": a.chunk_samples,
-        "engine": a._engine_request,
     }
 
 
@@ -192,6 +191,7 @@ def _configured(cls: Any, config: dict[str, Any]) -> Any:
     size = cfg.pop("parameters_size", None)
     if "gate" in cfg:  # states written before the guard was renamed
         cfg["guard"] = cfg.pop("gate")
+    cfg.pop("engine", None)  # states written while the kernel had an engine setting
     rule = cfg.pop("rule", None)
     if not isinstance(rule, dict):
         raise StateError("state['config']['rule'] must be an object of thresholds.")

@@ -1,4 +1,4 @@
-"""From buffered samples to trace rows: batches of windows through the engine.
+"""From buffered samples to trace rows: batches of windows through the kernel.
 
 Windows are independent, so batches may be solved on threads (``n_jobs``); the FSM output
 (accept or hold) then runs in time order over the solved batches.
@@ -12,8 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser import kernel
-from clpc.appraiser.engine import Engine
+from clpc.appraiser import engine, kernel
 from clpc.appraiser.trace import PER_EQUATION, Trace
 from clpc.core.rules import SolveSettings
 from clpc.model.structure import Structure
@@ -26,9 +25,8 @@ WINDOWS_PER_BATCH = 2048
 
 @dataclass(frozen=True)
 class KernelSetup:
-    """What the kernel needs, fixed for a record: the engine, the plan and the settings."""
+    """What the kernel needs, fixed for a record: the plan and the settings."""
 
-    engine: Engine
     plan: kernel.WindowPlan
     settings: SolveSettings
     fsm: kernel.FsmSettings
@@ -111,15 +109,15 @@ def solve_updates(
     n_jobs, mapper = threads
     parts = batches(updates[0], updates[1], n_jobs)
     if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
-        run = setup.engine.update
+        run = engine.update
         return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
 
     def solve(batch: tuple[int, int]) -> kernel.Solved:
-        return setup.engine.solve(buf, first_row, batch, setup.plan, setup.settings)
+        return engine.solve(buf, first_row, batch, setup.plan, setup.settings)
 
     solved = list(mapper(solve, parts))  # windows are independent: threads
     return [  # the FSM output runs in time order
-        (j0, count, _arrays(sol, setup.engine.output(sol, setup.fsm, state, setup.n_inputs)))
+        (j0, count, _arrays(sol, engine.output(sol, setup.fsm, state, setup.n_inputs)))
         for (j0, count), sol in zip(parts, solved, strict=True)
     ]
 

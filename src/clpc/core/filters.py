@@ -6,8 +6,9 @@ the same as its ``scipy.signal`` counterpart up to rounding (the tests compare t
 * :func:`fir` - ``lfilter(b, [1.0], x)``: a convolution (numpy);
 * :func:`all_pole` - ``lfilter([1.0], den, x, zi=lfiltic([1.0], den, past))``: the
   recursion ``y(n) = x(n) - den_1 y(n-1) - ... - den_na y(n-na)`` started from the
-  outputs before the first sample (compiled; ``scipy.signal.lfilter`` on the ``"python"``
-  engine, where a Python loop over the samples would be far too slow);
+  outputs before the first sample, solved as the banded lower-triangular system
+  ``A y = x`` by LAPACK's ``dtbtrs`` (forward substitution, ``scipy.linalg.lapack``) in
+  blocks of :data:`BLOCK` samples; nothing is compiled;
 * :func:`frequency_response` - ``freqz(b, a, worN=freqs, fs=fs)`` (numpy).
 
 ``scipy.signal`` is the reference, not a dependency of these paths: ``clpc track``'s
@@ -18,9 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from clpc.core.jit import compiled, kernel, resolve_engine
+__all__ = ["BLOCK", "all_pole", "fir", "frequency_response"]
 
-__all__ = ["all_pole", "fir", "frequency_response"]
+#: Samples per banded solve of :func:`all_pole` (its band matrix holds ``na + 1`` rows of this).
+BLOCK = 65536
 
 
 def fir(b: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -42,19 +44,6 @@ def fir(b: np.ndarray, x: np.ndarray) -> np.ndarray:
     if x.size == 0 or b.size == 0:
         return np.zeros(x.shape)
     return np.convolve(x, b)[: x.size]
-
-
-@kernel
-def _all_pole_loop(den, x, past, y):  # numba's subset: no annotations
-    na = den.size - 1
-    for t in range(x.size):
-        acc = x[t]
-        for k in range(1, na + 1):
-            if t >= k:
-                acc -= den[k] * y[t - k]
-            else:
-                acc -= den[k] * past[k - t - 1]
-        y[t] = acc
 
 
 def all_pole(den: np.ndarray, x: np.ndarray, past: np.ndarray | None = None) -> np.ndarray:
@@ -91,14 +80,24 @@ def all_pole(den: np.ndarray, x: np.ndarray, past: np.ndarray | None = None) -> 
         raise ValueError(f"past must hold the last {na} outputs; got shape {start.shape}.")
     if na == 0:
         return x.copy()
-    if resolve_engine("auto") == "python":
-        from scipy import signal  # the reference; a Python loop over samples is too slow
+    from scipy.linalg import lapack  # imported when used, as scipy.linalg elsewhere
 
-        zi = signal.lfiltic([1.0], den, start)
-        return np.asarray(signal.lfilter([1.0], den, x, zi=zi)[0])
-    y = np.empty_like(x)
-    compiled(_all_pole_loop)(den, x, start, y)
-    return y
+    n = x.size
+    y = np.empty(na + n)  # y(-na) .. y(-1), then the outputs
+    y[:na] = start[::-1]
+    size = min(BLOCK, max(n, 1))
+    band = np.asfortranarray(np.repeat(den[:, None], size, axis=1))  # ab[k, j] = A[j + k, j]
+    for lo in range(0, n, size):
+        m = min(size, n - lo)
+        rhs = x[lo : lo + m].copy()
+        for k in range(1, na + 1):  # the outputs before the block, moved to the right side
+            head = min(k, m)
+            rhs[:head] -= den[k] * y[na + lo - k : na + lo - k + head]
+        sol, info = lapack.dtbtrs(band[:, :m], rhs[:, None], uplo="L", diag="U")
+        if info != 0:  # pragma: no cover - a unit-diagonal band cannot be singular
+            raise RuntimeError(f"LAPACK dtbtrs failed (info = {info}).")
+        y[na + lo : na + lo + m] = sol[:, 0]
+    return y[na:]
 
 
 def frequency_response(

@@ -1,8 +1,8 @@
 """Polynomial helpers, written once: theta to monic form, and the Schur-Cohn stability test.
 
-Plain Python in numba's subset (see :mod:`clpc.core.jit`): the model calls them as they
-are, the CLPC kernel compiles them into its loop, :func:`monic_many` and
-:func:`stable_many` run them compiled over many equations at once.
+Plain Python in numba's subset, registered with ``numba.extending.register_jitable``: the
+model calls them as they are, the CLPC kernel compiles them into its loop, :func:`monic_many`
+and :func:`stable_many` run them compiled over many equations at once.
 
 Conventions (paper eq. 17, ``y^T a + u^T b = r``): ``theta = [a_0..a_na, b_0..b_nb, ...]``
 (one ``b`` block per input, or a single block for the paper's paired MIMO). The monic
@@ -12,9 +12,9 @@ form is ``A(z) = 1 + a_1/a_0 z^-1 + ...`` and ``B(z) = -(b_0 z^-nk + b_1 z^-(nk+
 
 from __future__ import annotations
 
+import numba
 import numpy as np
-
-from clpc.core.jit import compiled, kernel
+from numba.extending import register_jitable
 
 __all__ = [
     "UNIT_CIRCLE_TOL",
@@ -69,7 +69,7 @@ def pole_words(kind: str) -> str:
     }[kind]
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def schur_stable(den: np.ndarray, work: np.ndarray) -> bool:
     """Whether every root of ``den[0] z^n + ... + den[n]`` lies strictly inside the unit circle.
 
@@ -93,7 +93,7 @@ def schur_stable(den: np.ndarray, work: np.ndarray) -> bool:
     return True
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def monic(
     theta: np.ndarray,
     na: int,
@@ -121,7 +121,7 @@ def monic(
             num[target, nk + k] = -theta[na + 1 + blk * (nb + 1) + k] / a0
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _monic_rows(
     theta: np.ndarray, na: int, nb: int, nk: int, paired: bool, den: np.ndarray, num: np.ndarray
 ) -> None:
@@ -130,7 +130,7 @@ def _monic_rows(
             monic(theta[r, e], na, nb, nk, e if paired else -1, den[r, e], num[r, e])
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _stable_rows(den: np.ndarray, out: np.ndarray) -> None:
     work = np.empty(den.shape[1])
     for r in range(den.shape[0]):
@@ -164,7 +164,7 @@ def monic_many(
     den = np.empty((*flat.shape[:2], na + 1))
     num = np.empty((*flat.shape[:2], n_inputs, nk + nb + 1))
     if flat.shape[0]:
-        compiled(_monic_rows)(flat, na, nb, nk, paired, den, num)
+        _monic_rows(flat, na, nb, nk, paired, den, num)
     return den.reshape(*lead, *den.shape[1:]), num.reshape(*lead, *num.shape[1:])
 
 
@@ -174,7 +174,7 @@ def stable_many(den: np.ndarray) -> np.ndarray:
     flat = den.reshape(-1, den.shape[-1])
     out = np.zeros(flat.shape[0], dtype=np.bool_)
     if flat.shape[0]:
-        compiled(_stable_rows)(flat, out)
+        _stable_rows(flat, out)
     return out.reshape(den.shape[:-1])
 
 

@@ -1,9 +1,10 @@
 """Every rule of the LPC solution, written once (plain Python in numba's subset).
 
 The batch estimator (:class:`clpc.LPC`) calls these functions per equation after its numpy
-SVD; the CLPC kernel (:mod:`clpc.appraiser.kernel`) compiles them into its per-window loop
-(see :mod:`clpc.core.jit`). Thresholds are named constants or fields of
-:class:`RobustRule`; none is written as a bare literal in the logic.
+SVD, as plain Python; the CLPC kernel (:mod:`clpc.appraiser.kernel`) compiles them into its
+per-window loop (each is registered with ``numba.extending.register_jitable``). Thresholds
+are named constants or fields of :class:`RobustRule`; none is written as a bare literal in
+the logic.
 
 Paper (section III): with lag vectors ``z_n`` (eq. 36), mean ``Z`` (eq. 25) and scatter
 ``A = sum (z_n - Z)(z_n - Z)^T`` (eq. 27), the maximum-likelihood ``theta`` under
@@ -22,8 +23,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-
-from clpc.core.jit import kernel
+from numba.extending import register_jitable
 
 __all__ = [
     "CHANNEL_SCALES",
@@ -194,20 +194,20 @@ def solve_settings(
 
 
 # ------------------------------------------------------------------ statistics and verdicts
-@kernel
+@register_jitable(error_model="numpy")
 def likelihood_variance(noise_variance: float, lambda_max: float, n_rows: float) -> float:
     """``sigma_r^2`` floored at the rounding level of the window's own scale."""
     floor = ROUNDING_VARIANCE_FACTOR * _EPS * max(lambda_max, 0.0) / max(n_rows, 1.0)
     return max(noise_variance, floor, _TINY)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def index_j(variance: float, n_rows: float) -> float:
     """The paper's index ``J`` (eq. 22) at the solution: ``n/2 log sigma^2 + n/2``."""
     return 0.5 * n_rows * (math.log(variance) + 1.0)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def log_likelihood(variance: float, n_rows: float) -> float:
     """Gaussian log-likelihood at its maximum: ``-n/2 (log(2 pi sigma^2) + 1)``.
 
@@ -217,13 +217,13 @@ def log_likelihood(variance: float, n_rows: float) -> float:
     return -0.5 * n_rows * (_LOG_2PI + math.log(variance) + 1.0)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def eig_ratio(lambda_min: float, lambda_max: float) -> float:
     """Scale-free ``lambda_min / lambda_max`` (1 when nothing varies)."""
     return lambda_min / lambda_max if lambda_max > 0 else 1.0
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def is_determined(
     n_null: int, n_input: int, separation: float, degenerate: bool, separation_tol: float
 ) -> bool:
@@ -241,7 +241,7 @@ def trust_rows(p: int, window: int) -> int:
     return int(min(need, window))
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def is_excited(scat: np.ndarray, n_rows: float, step: float, n_out_cols: int) -> bool:
     """The output varies by at least :data:`EXCITATION_QUANTA` quantization steps.
 
@@ -260,7 +260,7 @@ def is_excited(scat: np.ndarray, n_rows: float, step: float, n_out_cols: int) ->
     return True
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def is_trusted(n_rows: float, need_rows: int, excited: bool, determined: bool) -> bool:
     """A window the guard trusts: enough rows, excited above quantization, determined.
 
@@ -274,7 +274,7 @@ def is_trusted(n_rows: float, need_rows: int, excited: bool, determined: bool) -
     return n_rows >= need_rows and excited and determined
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def accepts(
     not_enough: bool, degenerate: bool, a0_weight: float, guard: bool, trusted: bool
 ) -> bool:

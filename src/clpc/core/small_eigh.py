@@ -9,8 +9,8 @@ The algorithm is the classic pair used by EISPACK (``tred2``/``tql2``) and its p
 Java translation JAMA: Householder reduction to tridiagonal form accumulating the
 transformations, then the implicit QL iteration with Wilkinson-like shifts. It is backward
 stable: eigenvalues carry an absolute error of a few ``eps * ||A||``, like LAPACK's
-``dsyev``. The functions below are plain Python in numba's subset; :mod:`clpc.core.jit` compiles
-them into the CLPC kernel.
+``dsyev``. The functions below are plain Python in numba's subset, registered with
+``numba.extending.register_jitable``: the CLPC kernel compiles them into its loop.
 """
 
 from __future__ import annotations
@@ -18,8 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from clpc.core.jit import kernel
+from numba.extending import register_jitable
 
 __all__ = ["sym_eig"]
 
@@ -27,7 +26,7 @@ _EPS = 2.0**-52
 _MAX_QL_ITERATIONS = 60  # per eigenvalue; a few are needed in practice
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def sym_eig(a: np.ndarray, d: np.ndarray, v: np.ndarray, e: np.ndarray, vectors: bool) -> bool:
     """Eigenvalues (ascending) and, optionally, eigenvectors of a symmetric matrix.
 
@@ -59,7 +58,7 @@ def sym_eig(a: np.ndarray, d: np.ndarray, v: np.ndarray, e: np.ndarray, vectors:
     return _tql2(v, d, e, n, vectors)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _tred2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int) -> None:
     """Householder tridiagonalisation of ``v`` in place (``v`` becomes the transformation)."""
     for j in range(n):
@@ -134,7 +133,7 @@ def _tred2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int) -> None:
     e[0] = 0.0
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _tql2(v: np.ndarray, d: np.ndarray, e: np.ndarray, n: int, vectors: bool) -> bool:
     """Implicit QL iteration on the tridiagonal ``(d, e)``; rotations applied to ``v``."""
     for i in range(1, n):

@@ -1,7 +1,8 @@
 """The LPC solution of one equation: the solved problem, its near-null subspace, the vector.
 
-Plain Python in numba's subset, written once (:mod:`clpc.core.jit`): the batch estimator
-calls these functions after its numpy SVD, the CLPC kernel compiles them. Thresholds and
+Plain Python in numba's subset, written once: the batch estimator calls these functions
+after its numpy SVD (as plain Python), the CLPC kernel compiles them (each is registered
+with ``numba.extending.register_jitable``). Thresholds and
 settings are in :mod:`clpc.core.rules`.
 
 Paper (section III): with lag vectors ``z_n`` (eq. 36), mean ``Z`` (eq. 25) and scatter
@@ -16,8 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.extending import register_jitable
 
-from clpc.core.jit import kernel
 from clpc.core.rules import (
     CHANNEL_SCALES,
     CONSTANT_CHANNEL_FRACTION,
@@ -42,7 +43,7 @@ __all__ = [
 
 
 # ------------------------------------------------------------------ the solved problem
-@kernel
+@register_jitable(error_model="numpy")
 def channel_scales(
     scat: np.ndarray, n_rows: float, col_channel: np.ndarray, n_channels: int, scales: np.ndarray
 ) -> None:
@@ -65,7 +66,7 @@ def channel_scales(
                 scales[a] = std if std > 0 else 1.0
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def solved_matrix(
     scat: np.ndarray,
     mode: int,
@@ -107,7 +108,7 @@ def solved_matrix(
                 mat[a, b] = scat[a, b]
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def is_degenerate(
     scat: np.ndarray,
     mean: np.ndarray,
@@ -135,7 +136,7 @@ def is_degenerate(
     return False
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def degeneracy_ratio(fixed: float, p: int, n_rows: float) -> float:
     """``fixed`` if > 0, else the Marchenko-Pastur edge ratio for ``p`` columns, ``n`` rows."""
     if fixed > 0:
@@ -146,7 +147,7 @@ def degeneracy_ratio(fixed: float, p: int, n_rows: float) -> float:
     return min(((1 + x) / max(1 - x, 1e-12)) ** 2, MAX_DEGENERACY_RATIO)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def ratio(num: float, den: float) -> float:
     """``num / den`` clipped to [0, 1]; 1 when ``den`` is not positive."""
     num = max(num, 0.0)
@@ -157,7 +158,7 @@ def ratio(num: float, den: float) -> float:
 
 
 # ------------------------------------------------------------------ picking the vector
-@kernel
+@register_jitable(error_model="numpy")
 def unit_free_weights(
     vec: np.ndarray,
     transform: tuple[np.ndarray, np.ndarray, bool],
@@ -194,7 +195,7 @@ def unit_free_weights(
     return first / math.sqrt(total), out / total
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def pick_paper(
     eig: tuple[np.ndarray, np.ndarray],
     transform: tuple[np.ndarray, np.ndarray, bool],
@@ -211,7 +212,7 @@ def pick_paper(
     return 1, n_input, ratio(vals[0], vals[1] if p > 1 else vals[0])
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def pick_robust(
     eig: tuple[np.ndarray, np.ndarray],
     transform: tuple[np.ndarray, np.ndarray, bool],
@@ -264,7 +265,7 @@ def pick_robust(
     return last + 1, n_input, separation
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def normalise(theta: np.ndarray) -> None:
     """Unit norm and a deterministic sign: ``a0 > 0`` (else the first nonzero entry > 0)."""
     p = theta.shape[0]
@@ -283,7 +284,7 @@ def normalise(theta: np.ndarray) -> None:
         theta[a] = sign * theta[a]
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def solve_from_eig(
     scat: np.ndarray,
     mean: np.ndarray,

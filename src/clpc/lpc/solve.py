@@ -5,7 +5,7 @@ on a stack of problems (leading axis ``k``: equations), parameter axis ``p``. Th
 decomposition is numpy's (the SVD of the centered data when it is given: more accurate
 than the scatter's eigen-decomposition); everything decided from it - which vector, the
 near-null subspace, the flags, normalisation and sign, ``c`` and the noise variance - is
-the one source the CLPC kernel compiles.
+the one source the CLPC kernel compiles, called here as plain Python (nothing compiles).
 
 Paper (section III): with lag vectors ``z_n`` (rows of M, eq. 36), mean ``Z`` (eq. 25) and
 scatter ``A = sum (z_n - Z)(z_n - Z)^T`` (eq. 27), the maximum-likelihood parameter vector
@@ -21,7 +21,6 @@ under ``||theta|| = 1`` is the eigenvector of the smallest eigenvalue of ``A``
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,7 +28,6 @@ import numpy as np
 
 from clpc.core import rules, solution
 from clpc.core.checks import check_positive
-from clpc.core.jit import compiled, resolve_engine
 from clpc.core.rules import (
     NO_TRANSFORM,
     RobustRule,
@@ -80,11 +78,6 @@ class SolveResult:
     separation: np.ndarray
     degenerate: np.ndarray
     a0_weight: np.ndarray
-
-
-def engine_fn(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """The compiled twin of a rule, or the plain function under the ``"python"`` engine."""
-    return fn if resolve_engine("auto") == "python" else compiled(fn)
 
 
 def noise_covariance(
@@ -172,8 +165,6 @@ def solve_scatter(
     fixed = np.eye(p) if noise_cov is None else fixed_transform(noise_cov, p)
     settings = solve_settings(rule_, method == "robust", mode, n_output_cols, len(blocks))
     col_channel = _column_channels(blocks, p)
-    scales_of, matrix_of = engine_fn(solution.channel_scales), engine_fn(solution.solved_matrix)
-    finish = engine_fn(solution.solve_from_eig)
     out = {
         "theta": np.zeros((k, p)),
         "eigenvalues": np.zeros((k, p)),
@@ -184,11 +175,11 @@ def solve_scatter(
     }
     for i in range(k):
         scales, tmat, mat = np.ones(p), np.empty((p, p)), np.empty((p, p))
-        scales_of(scatter[i], n_rows_f[i], col_channel, len(blocks), scales)
-        matrix_of(scatter[i], mode, fixed, scales, tmat, mat)
+        solution.channel_scales(scatter[i], n_rows_f[i], col_channel, len(blocks), scales)
+        solution.solved_matrix(scatter[i], mode, fixed, scales, tmat, mat)
         rows = None if data is None or data.shape[1] < p else data[i]  # SVD needs n >= p
         vals, vecs, raw = _decompose(mat, tmat, scatter[i], rows, mode == NO_TRANSFORM)
-        res = finish(
+        res = solution.solve_from_eig(
             scatter[i],
             mean[i],
             n_rows_f[i],

@@ -71,13 +71,13 @@ def monic_arrays(models: list[LinearModel]) -> tuple[np.ndarray, np.ndarray, np.
 
 
 def free_run_from(
-    fitted: Fitted, sched: Schedule, u: np.ndarray, y: np.ndarray, split: int, engine: str
+    fitted: Fitted, sched: Schedule, u: np.ndarray, y: np.ndarray, split: int
 ) -> np.ndarray:
     """Blended free run of samples ``split..`` from the measured samples before ``split``."""
     yy = np.array(y, dtype=np.float64)
     yy[split:] = 0.0
     arrays = monic_arrays(fitted.local_models)
-    return blend_run(arrays, fitted.centres, fitted.widths, sched, u, yy, split, engine)[split:]
+    return blend_run(arrays, fitted.centres, fitted.widths, sched, u, yy, split)[split:]
 
 
 def blend_run(
@@ -88,11 +88,10 @@ def blend_run(
     u: np.ndarray,
     y: np.ndarray,
     start: int,
-    engine: str,
 ) -> np.ndarray:
     """Blended free run in place on ``y[start:]`` (compiled unless the schedule is a callable)."""
     if sched.kind != 2:
-        return run_blend(arrays, centres, widths, sched.code, u, y, start, engine)
+        return run_blend(arrays, centres, widths, sched.code, u, y, start)
     den, num, icpt = arrays
     lags_y, lags_u = den.shape[1], num.shape[2]
     for n in range(start, y.shape[0]):  # a Python callable: one call per sample
@@ -136,7 +135,7 @@ def fit_all(
     """Fit a multi-model to ``u`` (T, n_in), ``y`` (T,) (see the module).
 
     ``cfg`` holds ``structure``, ``n_inputs``, ``estimator``, ``dt``, ``method``,
-    ``n_models`` (None: automatic), ``max_models``, ``holdout``, ``tolerance``, ``engine``.
+    ``n_models`` (None: automatic), ``max_models``, ``holdout``, ``tolerance``.
     """
     s: Structure = cfg["structure"]
     start = max(s.max_lag, sched.lag)
@@ -181,7 +180,7 @@ def fit_all(
                 seen.add((c.size, est))
                 part = _fit_locals(rows[: split - start], psi[: split - start], c, cfg, est)
                 with np.errstate(all="ignore"):
-                    sim = free_run_from(part, sched, u, y, split, cfg["engine"])
+                    sim = free_run_from(part, sched, u, y, split)
                 fit = fit_percent(y[split:], sim)
                 table.append({"n_models": int(c.size), "estimator": est, "heldout_fit": fit})
         best = max(r["heldout_fit"] for r in table)

@@ -1,8 +1,8 @@
-"""Free-run loops of blended and time-varying difference equations (one source, two engines).
+"""Free-run loops of blended and time-varying difference equations (compiled by numba).
 
 A free run feeds each simulated output back, so it is sequential in time; these loops are
-:func:`clpc.core.jit.kernel` functions, compiled by numba unless the ``"python"`` engine is
-asked for (then the same code runs as plain Python: the reference).
+``numba.njit(cache=True)`` functions (with ``NUMBA_DISABLE_JIT=1`` the same code runs as
+plain Python).
 
 Every local model is stored in the monic form of :class:`clpc.LinearModel`: ``den``
 (shape (M, na+1), ``den[:, 0] = 1``), ``num`` (shape (M, n_in, L), ``L = nk + nb + 1``,
@@ -14,17 +14,14 @@ num_icl u_c(n-l)``.
 from __future__ import annotations
 
 import math
-from typing import Any
 
+import numba
 import numpy as np
-
-from clpc.core import jit
-from clpc.core.jit import kernel
 
 __all__ = ["run_blend", "run_varying"]
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _local_output(
     den: np.ndarray, num: np.ndarray, icpt: np.ndarray, i: int, y: np.ndarray, u: np.ndarray, n: int
 ) -> float:
@@ -38,7 +35,7 @@ def _local_output(
     return v
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _blend_loop(
     den: np.ndarray,
     num: np.ndarray,
@@ -77,17 +74,13 @@ def _blend_loop(
         y[n] = acc / total
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _varying_loop(
     den: np.ndarray, num: np.ndarray, icpt: np.ndarray, u: np.ndarray, y: np.ndarray, start: int
 ) -> None:
     """Fill ``y[start:]`` with a time-varying free run: sample ``n`` uses model ``n``."""
     for n in range(start, y.shape[0]):
         y[n] = _local_output(den, num, icpt, n, y, u, n)
-
-
-def _engine(fn: Any, engine: str) -> Any:
-    return fn if jit.resolve_engine(engine) == "python" else jit.compiled(fn)
 
 
 def run_blend(
@@ -98,7 +91,6 @@ def run_blend(
     u: np.ndarray,
     y: np.ndarray,
     start: int,
-    engine: str = "auto",
 ) -> np.ndarray:
     """Blended free run in place on ``y`` (float64, shape (T,)); returns ``y``.
 
@@ -107,8 +99,7 @@ def run_blend(
     """
     den, num, icpt = models
     inv_w = np.ascontiguousarray(1.0 / np.asarray(widths, dtype=np.float64))
-    loop = _engine(_blend_loop, engine)
-    loop(
+    _blend_loop(
         np.ascontiguousarray(den),
         np.ascontiguousarray(num),
         np.ascontiguousarray(icpt),
@@ -127,12 +118,10 @@ def run_varying(
     u: np.ndarray,
     y: np.ndarray,
     start: int,
-    engine: str = "auto",
 ) -> np.ndarray:
     """Time-varying free run in place on ``y`` (shape (T,)): model arrays have T rows."""
     den, num, icpt = models
-    loop = _engine(_varying_loop, engine)
-    loop(
+    _varying_loop(
         np.ascontiguousarray(den),
         np.ascontiguousarray(num),
         np.ascontiguousarray(icpt),

@@ -62,8 +62,6 @@ class MultiModel:
         Points of held-out fit within which fewer models are preferred (default 0.5).
     method : {"robust", "paper"}
         LPC solution (see :class:`clpc.LPC`).
-    engine : {"auto", "compiled", "python"}
-        Free-run loop: compiled by numba, or plain Python.
     """
 
     def __init__(
@@ -82,7 +80,6 @@ class MultiModel:
         holdout: float = 0.3,
         tolerance: float = 0.5,
         method: str = "robust",
-        engine: str = "auto",
     ) -> None:
         self.structure = Structure.from_settings(order, na, nb, nk)
         for name, value, low in (
@@ -110,7 +107,6 @@ class MultiModel:
             "holdout": float(holdout),
             "tolerance": float(tolerance),
             "method": method,
-            "engine": engine,
         }
         self.schedule_spec = schedule
         self._fitted: Fitted | None = None
@@ -241,10 +237,9 @@ class MultiModel:
             u0, _ = as_2d(u_init, self.n_inputs, "u_init")
             u0 = u0[-pad:]
             u_ext[pad - u0.shape[0] : pad] = u0
-        engine = self.settings["engine"]
         arrays = monic_arrays(f.local_models)
         with np.errstate(all="ignore"):
-            blend_run(arrays, f.centres, f.widths, sched, u_ext, y_ext, pad, engine)
+            blend_run(arrays, f.centres, f.widths, sched, u_ext, y_ext, pad)
         return y_ext[pad:]
 
     def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:

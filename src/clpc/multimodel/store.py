@@ -71,6 +71,7 @@ def from_dict(cls: Any, data: dict[str, Any]) -> Any:
         )
     s = data["structure"]
     settings = dict(data["settings"])
+    settings.pop("engine", None)  # files written while the free run had an engine setting
     mm = cls(na=s["na"], nb=s["nb"], nk=s["nk"], schedule=data["schedule"], **settings)
     mm.n_inputs, mm.dt = int(data["n_inputs"]), float(data["dt"])
     structure = mm.structure

@@ -11,9 +11,7 @@ from clpc.multimodel.kernels import run_varying
 __all__ = ["simulate_time_varying"]
 
 
-def simulate_time_varying(
-    den: Any, num: Any, intercept: Any, u: Any, y_init: Any, engine: str = "auto"
-) -> np.ndarray:
+def simulate_time_varying(den: Any, num: Any, intercept: Any, u: Any, y_init: Any) -> np.ndarray:
     """Simulate ``y(n) = k_n - sum_l den_n[l] y(n-l) + sum_l num_n[l] u(n-l)`` (SISO).
 
     Parameters
@@ -46,5 +44,5 @@ def simulate_time_varying(
         raise ValueError(f"y_init must hold the first {start} outputs; got {y0.size}.")
     y[:start] = y0
     return run_varying(
-        (d, nm[:, None, :], np.asarray(intercept, dtype=np.float64)), uu[:, None], y, start, engine
+        (d, nm[:, None, :], np.asarray(intercept, dtype=np.float64)), uu[:, None], y, start
     )

@@ -103,7 +103,7 @@ def _draw_in_two(jobs: list[FigureJob]) -> list[int]:
 
 
 def _warm_up() -> None:
-    """Import and touch what drawing needs: matplotlib, a font, the compiled filter."""
+    """Import and touch what drawing needs: matplotlib, a font, the model's filter."""
     import numpy as np
 
     from clpc.core.figure import new_figure

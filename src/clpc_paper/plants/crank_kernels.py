@@ -1,19 +1,20 @@
 """The crank servo's inner loop (one source, plain Python or compiled by numba).
 
-The equations are those of :mod:`clpc.plants.crank_servo`; the loop structure is the one
-of :func:`clpc.plants.servo_loop._servo_loop` (the drive runs once per controller period,
+The equations are those of :mod:`clpc_paper.plants.crank_servo`; the loop structure is the one
+of :func:`clpc_paper.plants.servo_loop._servo_loop` (the drive runs once per controller period,
 the mechanics ``substeps`` times, sample ``i`` is logged at the start of the controller
 period that begins at ``t_i``), and the scalar helpers (clip, soft threshold, quantiser)
-are the servo's own :mod:`clpc.plants.servo_kernels`.
+are the servo's own :mod:`clpc_paper.plants.servo_kernels`.
 """
 
 from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
+from numba.extending import register_jitable
 
-from clpc.core.jit import kernel
 from clpc_paper.plants.servo_kernels import _clip, _quantise, _soft_threshold
 
 __all__ = ["N_OUT", "N_P", "N_STATE"]
@@ -28,7 +29,7 @@ N_STATE = 5
 N_OUT = 5
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _crank_mechanics(p: np.ndarray, th: float, w: float, tau: float, h: float) -> tuple:
     """One semi-implicit Euler step ``h`` [s] of the crank under motor torque ``tau`` [N m].
 
@@ -43,7 +44,7 @@ def _crank_mechanics(p: np.ndarray, th: float, w: float, tau: float, h: float) -
     return th + h * w_new, w_new
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _crank_loop(
     p: np.ndarray,
     steps: int,

@@ -1,6 +1,6 @@
 r"""A servo lifting a load through a crank: dynamics that change with the position.
 
-The existing servo (:mod:`clpc.plants.servo`) is linear at the paper's amplitudes: its
+The existing servo (:mod:`clpc_paper.plants.servo`) is linear at the paper's amplitudes: its
 velocity integrator cancels the only position-dependent load. Here a motor lifts a mass
 ``m`` on a crank of radius ``r`` (a scotch yoke), so gravity and the reflected inertia
 depend on the angle ``th``::
@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core import jit
+from clpc_paper.checks import check_choice
 from clpc_paper.plants.crank_commands import crank_commands
 from clpc_paper.plants.crank_kernels import N_OUT, N_P, N_STATE, _crank_loop
 from clpc_paper.plants.servo_inputs import _check_signal, _streams
@@ -230,7 +230,8 @@ def simulate_crank_servo(
     state[2] = y0  # last reading: at rest
     state[4] = 0.0 if prm.velocity_integrator == 0 else prm.gravity_torque * math.sin(y0)
     out = np.empty((cmd.shape[0], N_OUT))
-    loop = _crank_loop if jit.resolve_engine(engine) == "python" else jit.compiled(_crank_loop)
+    python = check_choice(engine, "engine", ("auto", "compiled", "python")) == "python"
+    loop = getattr(_crank_loop, "py_func", _crank_loop) if python else _crank_loop
     loop(prm.packed(float(sample_time)), steps, prm.mechanical_substeps, cmd, noise, state, out)
     return CrankRecord(
         command=_readonly(cmd),

@@ -1,13 +1,14 @@
 """The pieces the servo loop calls once per controller step (one source, two engines).
 
-Every function here is a :func:`clpc.core.jit.kernel`: plain Python in the ``"python"``
-engine, compiled with the loop by numba otherwise. They take and return scalars and
-NamedTuples of scalars (which numba keeps in registers), so the compiled loop stays fast and
-both engines compute the same operations in the same order: bit-identical numbers.
+Every function here is registered with ``numba.extending.register_jitable``: plain
+Python in the ``"python"`` engine, compiled with the loop by numba otherwise. They take and
+return scalars and NamedTuples of scalars (which numba keeps in registers), so the compiled
+loop stays fast and both engines compute the same operations in the same order:
+bit-identical numbers.
 
 The drive (:func:`_drive_step`) and the discretised mechanics (:func:`_mechanics_step`:
 symplectic Euler with implicit viscous and Coulomb friction) implement the equations of
-the "Continuous-time model" and "Discretisation" sections of :mod:`clpc.plants.servo`.
+the "Continuous-time model" and "Discretisation" sections of :mod:`clpc_paper.plants.servo`.
 """
 
 from __future__ import annotations
@@ -16,8 +17,8 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numba.extending import register_jitable
 
-from clpc.core.jit import kernel
 from clpc_paper.plants.servo_layout import (
     _O_TAU,
     _O_THL,
@@ -106,7 +107,7 @@ class Mechanics(NamedTuple):
     rigid: bool
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _clip(x: float, limit: float) -> float:
     """``x`` limited to ``[-limit, limit]``."""
     if x > limit:
@@ -116,7 +117,7 @@ def _clip(x: float, limit: float) -> float:
     return x
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _soft_threshold(x: float, thr: float) -> float:
     """``sign(x) max(|x| - thr, 0)``: the implicit Coulomb friction step."""
     if x > thr:
@@ -126,7 +127,7 @@ def _soft_threshold(x: float, thr: float) -> float:
     return 0.0
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _quantise(x: float, res: float, inv_res: float) -> float:
     """Resolver reading of ``x`` [rad] with step ``res`` (``inv_res = 1 / res``; 0: none)."""
     if res > 0.0:
@@ -134,7 +135,7 @@ def _quantise(x: float, res: float, inv_res: float) -> float:
     return x
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _biquad(
     filt: np.ndarray, row: int, x: float, z1: float, z2: float
 ) -> tuple[float, float, float]:
@@ -143,13 +144,13 @@ def _biquad(
     return y, filt[row, 1] * x - filt[row, 3] * y + z2, filt[row, 2] * x - filt[row, 4] * y
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _gains(p: np.ndarray) -> Gains:
     """Controller constants from the packed parameters ``p``, shape ``(_N_P,)``."""
     return Gains(p[_P_KP], p[_P_KV], p[_P_KVKI_TC], p[_P_VLIM], p[_P_TLIM], 1.0 / p[_P_TC])
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _mechanics(p: np.ndarray, substeps: int) -> Mechanics:
     """Step ``h = T_c / substeps`` and its friction thresholds and viscous divisors."""
     rigid = p[_P_RIGID] != 0.0
@@ -176,7 +177,7 @@ def _mechanics(p: np.ndarray, substeps: int) -> Mechanics:
     )
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _drive_step(
     g: Gains, filt: np.ndarray, d: Drive, r: float, y: float
 ) -> tuple[float, float, Drive]:
@@ -206,7 +207,7 @@ def _drive_step(
     return v_cmd, tau, Drive(y, integ, lp1, lp2, no1, no2, vf1, vf2)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _mechanics_step(m: Mechanics, s: Shaft, tau: float) -> Shaft:
     """One symplectic Euler step ``m.h`` of the shafts under motor torque ``tau`` [N m]."""
     if m.rigid:
@@ -219,7 +220,7 @@ def _mechanics_step(m: Mechanics, s: Shaft, tau: float) -> Shaft:
     return Shaft(s.th_m + m.h * w_m, w_m, s.th_l + m.h * w_l, w_l)
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _load_state(state: np.ndarray) -> tuple[Shaft, Drive]:
     """Shafts and controller from the state vector, shape ``(_N_S,)``."""
     shaft = Shaft(state[_S_THM], state[_S_WM], state[_S_THL], state[_S_WL])
@@ -236,7 +237,7 @@ def _load_state(state: np.ndarray) -> tuple[Shaft, Drive]:
     return shaft, drive
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _store_state(state: np.ndarray, shaft: Shaft, drive: Drive) -> None:
     """Write shafts and controller back into the state vector, shape ``(_N_S,)``."""
     state[_S_THM], state[_S_WM], state[_S_THL], state[_S_WL] = shaft
@@ -250,7 +251,7 @@ def _store_state(state: np.ndarray, shaft: Shaft, drive: Drive) -> None:
     state[_S_VF2] = drive.vf2
 
 
-@kernel
+@register_jitable(error_model="numpy")
 def _log_sample(out: np.ndarray, i: int, y: float, s: Shaft, v_cmd: float, tau: float) -> None:
     """Row ``i`` of ``out``, shape ``(n, _N_OUT)``: reading, shafts, commands."""
     out[i, _O_Y] = y

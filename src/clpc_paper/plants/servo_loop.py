@@ -1,9 +1,9 @@
 """The servo's inner loop (one source) and the choice between its two engines.
 
 :func:`_servo_loop` runs the drive and the mechanics over one chunk of logged samples; the
-steps it takes are the kernels of :mod:`clpc.plants.servo_kernels`. The same function runs
-as plain Python (``engine="python"``, :data:`_servo_loop_py`) or compiled by numba through
-:func:`clpc.core.jit.compiled` (``_servo_loop_jit``, built on first use).
+steps it takes are the kernels of :mod:`clpc_paper.plants.servo_kernels`. The same function runs
+as plain Python (``engine="python"``, :data:`_servo_loop_py`) or compiled by numba
+(``numba.njit(cache=True)``: ``_servo_loop_jit``, compiled on first use).
 
 Sample ``i`` is logged at the start of the controller period that begins at ``t_i``: the
 resolver reading the drive uses, the true states and the velocity command computed then.
@@ -18,10 +18,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import numba
 import numpy as np
 
-from clpc.core import jit
-from clpc.core.jit import kernel
 from clpc_paper.checks import check_choice
 from clpc_paper.plants.servo_kernels import (
     _clip,
@@ -49,7 +48,7 @@ __all__ = ["numba_available"]
 Loop = Callable[[LoopConfig, LoopInputs, np.ndarray, np.ndarray], None]
 
 
-@kernel
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _servo_loop(config: LoopConfig, inputs: LoopInputs, state: np.ndarray, out: np.ndarray) -> None:
     """Run the drive and the mechanics over one chunk of samples, in place.
 
@@ -105,8 +104,9 @@ def _servo_loop(config: LoopConfig, inputs: LoopInputs, state: np.ndarray, out: 
     _store_state(state, shaft, drive)
 
 
-#: The loop as plain Python (the reference; always available).
-_servo_loop_py: Loop = _servo_loop
+#: The loop as plain Python (the reference; always available; the function itself when
+#: ``NUMBA_DISABLE_JIT=1``).
+_servo_loop_py: Loop = getattr(_servo_loop, "py_func", _servo_loop)
 
 _JIT_CACHE: dict[str, Loop | None] = {}
 
@@ -114,7 +114,7 @@ _JIT_CACHE: dict[str, Loop | None] = {}
 def _compiled_loop() -> Loop | None:
     """Return the numba-compiled loop, or ``None`` if numba is not installed."""
     if "loop" not in _JIT_CACHE:
-        _JIT_CACHE["loop"] = jit.compiled(_servo_loop) if jit.numba_available() else None
+        _JIT_CACHE["loop"] = _servo_loop
     return _JIT_CACHE["loop"]
 
 
@@ -124,7 +124,7 @@ def numba_available() -> bool:
     Returns
     -------
     bool
-        ``True`` if :func:`clpc.plants.simulate_servo` runs compiled code by default.
+        ``True`` if :func:`clpc_paper.plants.simulate_servo` runs compiled code by default.
     """
     return _compiled_loop() is not None
 
