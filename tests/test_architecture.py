@@ -1,4 +1,4 @@
-"""The package's layers: no import runs back up, no import cycle, old module paths still work.
+"""The package's layers: no import runs back up, no import cycle, no old flat module path.
 
 Every ``import`` in ``src/clpc`` (module level and inside functions) is parsed with ``ast``;
 each module belongs to the layer of its longest matching prefix in ``LAYERS``.
@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 
 import clpc
-from clpc._moved import MOVED
 
 SRC = Path(clpc.__file__).resolve().parent
 
@@ -32,7 +31,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("clpc.experiment",),
     ("clpc.workflows",),
     ("clpc.cli", "clpc.__main__"),
-    ("clpc", "clpc._moved"),  # the package facade re-exports everything
+    ("clpc",),  # the package facade re-exports everything
 ]
 
 
@@ -140,6 +139,6 @@ def test_the_layer_check_sees_a_violation():
     assert _layer("clpc.core.rules") == 0
 
 
-@pytest.mark.parametrize(("old", "new"), sorted(MOVED.items()))
-def test_old_module_paths_still_import(old, new):
-    assert importlib.import_module(old) is importlib.import_module(new)
+def test_old_flat_module_paths_are_gone():
+    with pytest.raises(ModuleNotFoundError):
+        importlib.import_module("clpc.solve")

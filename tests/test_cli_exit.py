@@ -43,7 +43,7 @@ def test_exit_codes_and_messages(args, code, where):
 
 
 def test_every_line_of_a_long_output_arrives_through_a_pipe(samples):
-    args = ["stream", "--order", "1", "--window", "50", "--cluster", "5"]
+    args = ["stream", "--order", "1", "--window-size", "50", "--cluster-size", "5"]
     done = _clpc(args, stdin=samples)
     assert done.returncode == 0
     lines = done.stdout.splitlines()

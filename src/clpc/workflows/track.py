@@ -321,14 +321,14 @@ def _chunks(record: RecordSpec, chunk_rows: int, progress: ChunkFilter | None) -
 
 
 def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> None:
-    needed = settings.appraiser.window + run.appraiser.structure.max_lag
+    needed = settings.appraiser.window_size + run.appraiser.structure.max_lag
     if run.appraiser.n_samples < needed or not run.kept.seen:
         trace_file.unlink(missing_ok=True)
         raise DataError(
             f"the record is too short for the window: {run.appraiser.n_samples} sample(s) "
-            f"(of {run.n_raw} read) but --window {settings.appraiser.window} with "
+            f"(of {run.n_raw} read) but --window-size {settings.appraiser.window_size} with "
             f"--order {settings.appraiser.order} needs at least {needed}; "
-            "use a smaller --window or a longer record."
+            "use a smaller --window-size or a longer record."
         )
 
 
