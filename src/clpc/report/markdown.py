@@ -1,6 +1,9 @@
-r"""The small Markdown subset the reports emit, as HTML (no dependency).
+r"""The small Markdown subset of the experiment's ``report.md``, as HTML (no dependency).
 
-Handles what :mod:`clpc.experiment` writes into ``report.md``: ``#``/``##`` headings,
+Used by :mod:`clpc.experiment.html_report` alone (and leaves with the experiment): clpc's own
+reports, ``clpc track`` and ``clpc identify --report``, are built as HTML directly
+(:mod:`clpc.report.html`, checked by ``tests/test_architecture.py``). Handles what
+:mod:`clpc.experiment` writes into ``report.md``: ``#``/``##`` headings,
 paragraphs, pipe tables (``\|`` escapes a bar inside a cell), images on their own line
 (an image followed by a paragraph opening with its caption in ``*...*`` becomes one
 ``<figure>``), bullet lists (continuation lines indented), block quotes and inline
