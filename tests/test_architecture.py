@@ -18,7 +18,7 @@ SRC = Path(clpc.__file__).resolve().parent
 
 #: bottom to top; a module may import its own layer or any layer below it
 LAYERS: list[tuple[str, ...]] = [
-    ("clpc._version", "clpc.core"),
+    ("clpc._version", "clpc._schema", "clpc.core"),
     ("clpc.data",),
     ("clpc.model",),
     ("clpc.lpc",),
