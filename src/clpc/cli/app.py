@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ast
 import functools
+import gc
 import importlib
 import importlib.util
 from collections.abc import Sequence
@@ -113,6 +114,13 @@ def main(argv: Sequence[str] | None = None) -> None:
 def run() -> None:
     """The process's entry point (``clpc``, ``python -m clpc``): :func:`main`.
 
-    Raises :class:`SystemExit` with the exit status; the interpreter then exits normally.
+    Raises :class:`SystemExit` with the exit status; the interpreter then exits normally
+    (exit handlers, flushed streams, modules torn down). Before that the objects alive are
+    moved out of the cyclic garbage collector's reach (:func:`gc.freeze`): its last passes
+    over numba's, scipy's and matplotlib's objects took 0.3-1.4 s of a command's exit and
+    free nothing the process still needs (every file clpc writes is closed by then).
     """
-    main()
+    try:
+        main()
+    finally:
+        gc.freeze()
