@@ -7,10 +7,9 @@ Side by side in one run, each the best of ``--repeat`` (the two paths alternatin
   when installed); ``pandas.read_csv`` and ``pyarrow.csv.read_csv`` as outside references.
   The values must be identical.
 * ``python -m clpc track`` on the same file (subprocesses, all variants alternating):
-  ``CLPC_FAST_IO=0`` (plain reader and the plain trace writer), ``CLPC_PAINTER=0`` (every
-  figure drawn in the command's own process) and the default, and with ``--baseline-src``
-  the package before issue 16 (commit 64b4459) as well; every ``trace.csv`` must hold the
-  same numbers. The phases of one in-process run are timed too
+  ``CLPC_FAST_IO=0`` (plain reader and the plain trace writer) and the default, and with
+  ``--baseline-src`` the package before issue 16 (commit 64b4459) as well; every
+  ``trace.csv`` must hold the same numbers. The phases of one in-process run are timed too
   (read, appraise, write the trace, figures and report), to show where the time goes.
 * start-up: ``python -c "import clpc"``, ``clpc --help``, and the eager import of every
   exported name (what ``import clpc`` cost before the names were loaded lazily).
@@ -86,7 +85,6 @@ def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) ->
     cmd = [sys.executable, "-m", "clpc", "track", path, "-u", "u", "-y", "y", "--out"]
     variants = {
         "plain": dict(os.environ, CLPC_FAST_IO="0"),
-        "serial": dict(os.environ, CLPC_PAINTER="0"),
         "default": dict(os.environ),
     }
     if baseline_src:  # the package before the work on issue 16 (commit 64b4459)
@@ -105,17 +103,10 @@ def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) ->
         name: np.array_equal(t.data, ref.data) and t.names == ref.names
         for name, t in traces.items()
     }
-    files = sorted(p.name for p in (work / "default").iterdir())
-    same_files = [
-        name
-        for name in files
-        if (work / "serial" / name).read_bytes() == (work / "default" / name).read_bytes()
-    ]
     print(f"\n## clpc track, end to end (subprocess wall time, best of {repeat}, alternating)")
     labels = {
         "baseline": f"baseline package ({baseline_src})",
         "plain": "plain path (CLPC_FAST_IO=0)",
-        "serial": "figures in one process (CLPC_PAINTER=0)",
         "default": "default",
     }
     for name, t in best.items():
@@ -128,15 +119,10 @@ def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) ->
         print(f"{labels[name]:<45} {t:6.2f} s (median {median:.2f} s)   ({ratios})")
     every = "; ".join(f"{n}: " + " ".join(f"{x:.2f}" for x in t) for n, t in times.items())
     print(f"(every run [s]: {every})")
-    print(
-        f"trace.csv: same numbers as the default: {same} ({ref.n_rows} updates); files "
-        f"byte-identical with and without the painter: {len(same_files)} of {len(files)} "
-        f"({', '.join(same_files)})"
-    )
+    print(f"trace.csv: same numbers as the default: {same} ({ref.n_rows} updates)")
     for label, env in (("plain", "0"), ("default", "1")):
         print(f"phases ({label}): {phases(path, work / f'phases-{label}', env)}")
     assert all(same.values()), "a path changed the trace"
-    assert len(same_files) == len(files), "the painter changed a file"
 
 
 def phases(path: str, out: Path, fast_io: str) -> str:

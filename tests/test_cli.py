@@ -215,9 +215,9 @@ def test_track_writes_trace_figures_report(record, tmp_path):
         "y",
         "--time",
         "t",
-        "--window",
+        "--window-size",
         "101",
-        "--cluster",
+        "--cluster-size",
         "10",
         "--chunk-rows",
         "97",
@@ -259,7 +259,7 @@ def test_track_parquet_progress_and_mimo(tmp_path):
         "y1",
         "-y",
         "y2",
-        "--window",
+        "--window-size",
         "101",
         "--out",
         tmp_path,
@@ -274,14 +274,14 @@ def test_track_parquet_progress_and_mimo(tmp_path):
 
 def test_track_errors(record, tmp_path):
     path, *_ = record
-    r = fails(1, "track", path, "-u", "u", "-y", "y", "--window", "5000", "--out", tmp_path)
+    r = fails(1, "track", path, "-u", "u", "-y", "y", "--window-size", "5000", "--out", tmp_path)
     assert "too short for the window" in r.output and "needs at least 5002" in r.output
     bad_time = tmp_path / "bad_time.csv"
     write_table(bad_time, ["t", "u", "y"], [[0, 1, 2], [0.1, 2, 3], [0.3, 3, 4], [0.4, 1, 1]])
     r = fails(1, "track", bad_time, "-u", "u", "-y", "y", "--time", "t", "--out", tmp_path)
     assert "not uniformly" in r.output
     fails(2, "track", path, "-u", "u", "-y", "y", "--out", tmp_path, "--dt", "1", "--time", "t")
-    fails(2, "track", path, "-u", "u", "-y", "y", "--out", tmp_path, "--window", "1")
+    fails(2, "track", path, "-u", "u", "-y", "y", "--out", tmp_path, "--window-size", "1")
     fails(2, "track", path, "-u", "u", "-y", "y")  # --out missing
 
 
@@ -317,7 +317,7 @@ def test_stream_in_process_skips_malformed_lines(record):
     _, u, y, _ = record
     u, y = u[:300], y[:300]
     text, bad_lines = _stream_lines(u, y, BAD)
-    res = ok("stream", "--window", "51", "--cluster", "7", input=text)
+    res = ok("stream", "--window-size", "51", "--cluster-size", "7", input=text)
     got = [json.loads(line) for line in res.stdout.splitlines()]
     _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
     for no in bad_lines:
@@ -328,7 +328,9 @@ def test_stream_in_process_skips_malformed_lines(record):
 def test_stream_stop_on_error(record):
     _, u, y, _ = record
     text, bad_lines = _stream_lines(u[:100], y[:100], {60: "1,x"})
-    res = fails(1, "stream", "--window", "20", "--cluster", "5", "--on-error", "stop", input=text)
+    res = fails(
+        1, "stream", "--window-size", "20", "--cluster-size", "5", "--on-error", "stop", input=text
+    )
     assert f"line {bad_lines[0]}: field 2 'x' is not a number" in res.stderr
     # the updates before the bad line were written
     assert len(res.stdout.splitlines()) == len(clpc.CLPC(3, 20, 5).run(u[:60], y[:60]))
@@ -351,9 +353,9 @@ def test_stream_jsonl_mimo_and_sample_time(rng):
         "2",
         "--outputs",
         "2",
-        "--window",
+        "--window-size",
         "40",
-        "--cluster",
+        "--cluster-size",
         "10",
         "--dt",
         "0.5",
@@ -374,7 +376,7 @@ def test_stream_through_a_real_pipe(record):
     _, u, y, _ = record
     text, bad_lines = _stream_lines(u, y, BAD)
     lines = text.splitlines(keepends=True)
-    cmd = [sys.executable, "-m", "clpc", "stream", "--window", "51", "--cluster", "7"]
+    cmd = [sys.executable, "-m", "clpc", "stream", "--window-size", "51", "--cluster-size", "7"]
     proc = subprocess.Popen(
         cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, bufsize=0
     )
@@ -475,7 +477,7 @@ def test_usage_errors_exit_2(record, tmp_path):
     fails(2, "identify", path, "-u", "u")  # --output missing
     r = fails(2, "identify", path, "-u", "u", "-y", "y", "--dt", "0.01", "--time", "t")
     assert "either --dt or --time" in r.output
-    fails(2, "stream", "--cluster", "0")
+    fails(2, "stream", "--cluster-size", "0")
     fails(2, "stream", "--format", "xml")
     fails(2, "nonsense")
     model_file = tmp_path / "m.json"
@@ -534,8 +536,8 @@ def test_workflows_without_the_command_line(record, tmp_path):
         wf.simulate_file(model_file, path, ("u", "y"))
     with pytest.raises(wf.SamplingConflictError):
         wf.RecordSpec(path, ("u",), ("y",), dt=dt, time_col="t").load()
-    with pytest.raises(ValueError, match="window must be an int"):
-        wf.AppraiserSettings(window=1)
+    with pytest.raises(ValueError, match="window_size must be an int"):
+        wf.AppraiserSettings(window_size=1)
     with pytest.raises(ValueError, match="order must be an int"):
         wf.IdentifySettings(rec, order=0)
 
@@ -544,7 +546,7 @@ def test_stream_samples_matches_a_batch_run(record):
     _, u, y, _ = record
     text, bad_lines = _stream_lines(u[:200], y[:200], {10: "1,x"})
     lines = text.splitlines()
-    settings = wf.StreamSettings(wf.AppraiserSettings(window=40, cluster=9))
+    settings = wf.StreamSettings(wf.AppraiserSettings(window_size=40, cluster_size=9))
     batches = list(wf.stream_samples([lines[:50], lines[50:]], settings))
     records = [r for b in batches for r in b.records]
     _assert_same_updates(records, update_records(clpc.CLPC(3, 40, 9).run(u[:200], y[:200])))
@@ -580,7 +582,14 @@ def test_stream_jsonl_survives_huge_numbers_and_deep_nesting(record):
     lines.insert(50, '{"u": 1' + "0" * 400 + ', "y": 1}')  # an int no float can hold
     lines.insert(120, "[" * 100_000)  # deeper than the JSON parser recurses
     res = ok(
-        "stream", "--format", "jsonl", "--window", "51", "--cluster", "7", input="\n".join(lines)
+        "stream",
+        "--format",
+        "jsonl",
+        "--window-size",
+        "51",
+        "--cluster-size",
+        "7",
+        input="\n".join(lines),
     )
     got = [json.loads(line) for line in res.stdout.splitlines()]
     _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))

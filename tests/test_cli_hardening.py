@@ -64,7 +64,7 @@ def test_track_save_with_nothing_accepted_fails(tmp_path):
         "u",
         "-y",
         "y",
-        "--window",
+        "--window-size",
         "51",
         "--out",
         tmp_path / "o",
@@ -87,7 +87,7 @@ def test_track_window_too_small_fails(tmp_path, sig):
     u, y = sig
     path = tmp_path / "r.csv"
     write_table(path, ["u", "y"], np.column_stack([u, y]))
-    res = run("track", path, "-u", "u", "-y", "y", "--window", "3", "--out", tmp_path)
+    res = run("track", path, "-u", "u", "-y", "y", "--window-size", "3", "--out", tmp_path)
     assert res.exit_code != 0 and "cannot hold" in res.output
 
 
@@ -101,7 +101,7 @@ def test_stream_without_a_valid_sample_exits_nonzero():
 
 
 def test_stream_window_too_small_fails():
-    res = run("stream", "--window", "3", input="1,2\n3,4\n")
+    res = run("stream", "--window-size", "3", input="1,2\n3,4\n")
     assert res.exit_code != 0 and "cannot hold" in res.output
 
 
@@ -162,9 +162,9 @@ def test_stream_skips_every_malformed_line_and_keeps_the_rest(sig, fmt, bad):
         "stream",
         "--format",
         fmt,
-        "--window",
+        "--window-size",
         "51",
-        "--cluster",
+        "--cluster-size",
         "7",
         input="\n".join(lines) + "\n",
     )
@@ -179,18 +179,30 @@ def test_stream_skips_every_malformed_line_and_keeps_the_rest(sig, fmt, bad):
 def test_stream_first_line_that_is_not_data_is_reported(sig):
     u, y = sig
     for first in ("hello", "a,b,c"):
-        res = code(0, "stream", "--window", "51", "--cluster", "7", input=first + "\n" + _csv(u, y))
+        res = code(
+            0,
+            "stream",
+            "--window-size",
+            "51",
+            "--cluster-size",
+            "7",
+            input=first + "\n" + _csv(u, y),
+        )
         assert "line 1:" in res.stderr, res.stderr
         got = [json.loads(x) for x in res.stdout.splitlines()]
         _same(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
-    res = code(0, "stream", "--window", "51", "--cluster", "7", input="u,y\n" + _csv(u, y))
+    res = code(
+        0, "stream", "--window-size", "51", "--cluster-size", "7", input="u,y\n" + _csv(u, y)
+    )
     assert "header" in res.stderr and "u, y" in res.stderr
 
 
 def test_stream_header_with_a_data_like_name_is_not_swallowed(sig):
     u, y = sig
     # "1e3" is a number: the first line is data, not a header
-    res = code(0, "stream", "--window", "51", "--cluster", "7", input="1e3,2\n" + _csv(u, y))
+    res = code(
+        0, "stream", "--window-size", "51", "--cluster-size", "7", input="1e3,2\n" + _csv(u, y)
+    )
     got = [json.loads(x) for x in res.stdout.splitlines()]
     _same(got, update_records(clpc.CLPC(3, 51, 7).run(np.r_[1e3, u], np.r_[2, y])))
     assert "header" not in res.stderr
@@ -216,9 +228,9 @@ def test_stream_selects_columns_by_name_and_index(sig):
         "pos",
         "--time",
         "t",
-        "--window",
+        "--window-size",
         "51",
-        "--cluster",
+        "--cluster-size",
         "7",
         input=text,
     )
@@ -226,7 +238,9 @@ def test_stream_selects_columns_by_name_and_index(sig):
     assert json.loads(res.stdout.splitlines()[0])["time"] == pytest.approx(
         0.5 * json.loads(res.stdout.splitlines()[0])["index"]
     )
-    res = code(0, "stream", "-u", "3", "-y", "1", "--window", "51", "--cluster", "7", input=rows)
+    res = code(
+        0, "stream", "-u", "3", "-y", "1", "--window-size", "51", "--cluster-size", "7", input=rows
+    )
     _same(
         [json.loads(x) for x in res.stdout.splitlines()],
         update_records(clpc.CLPC(3, 51, 7).run(u, y)),
@@ -245,9 +259,9 @@ def test_stream_selects_columns_by_name_and_index(sig):
         "V",
         "-y",
         "x",
-        "--window",
+        "--window-size",
         "51",
-        "--cluster",
+        "--cluster-size",
         "7",
         input=jl,
     )
@@ -285,7 +299,7 @@ def test_stream_reads_a_named_pipe_without_loss(tmp_path, sig):
     t.start()
     with open(fifo) as src:
         proc = subprocess.run(
-            [sys.executable, "-m", "clpc", "stream", "--window", "51", "--cluster", "7"],
+            [sys.executable, "-m", "clpc", "stream", "--window-size", "51", "--cluster-size", "7"],
             stdin=src,
             capture_output=True,
             text=True,

@@ -52,7 +52,7 @@ def test_long_stream_with_bad_lines_matches_a_batch_run_in_flat_memory():
     y = clpc.simulate_arx(np.array([1.0, -1.5, 0.7]), np.array([0.2, 0.5, 0.1]), u)
     y += 0.01 * rng.standard_normal(n)
     proc = subprocess.Popen(
-        [sys.executable, "-m", "clpc", "stream", "--window", "201", "--cluster", "12"],
+        [sys.executable, "-m", "clpc", "stream", "--window-size", "201", "--cluster-size", "12"],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,

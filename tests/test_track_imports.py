@@ -68,8 +68,7 @@ def test_the_whole_track_run_with_its_report_needs_neither_scipy_signal_nor_stat
     out = tmp_path / "out"
     loaded = _modules_after(
         f"""
-        import contextlib, io, os
-        os.environ["CLPC_PAINTER"] = "0"  # every figure drawn in this interpreter
+        import contextlib, io
         from clpc.cli import main
         with contextlib.redirect_stdout(io.StringIO()):
             try:

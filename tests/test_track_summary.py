@@ -26,7 +26,7 @@ def long_record(tmp_path_factory):
 def test_summary_counts_convergence_and_model_come_from_the_full_trace(long_record, tmp_path):
     pytest.importorskip("matplotlib")
     path, u, y = long_record
-    appraiser = wf.AppraiserSettings(parameters_size=3, window=101, cluster=10, nk=1)
+    appraiser = wf.AppraiserSettings(order=2, window_size=101, cluster_size=10, nk=1)
     settings = wf.TrackSettings(
         wf.RecordSpec(path, ("u",), ("y",)),
         str(tmp_path),

@@ -15,7 +15,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from clpc import _moved
 from clpc._version import __version__
 
 if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on first use
@@ -50,8 +49,6 @@ if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on fi
     )
     from clpc.model.residuals import ResidualAnalysis, residual_analysis
     from clpc.multimodel import MultiModel
-
-_moved.install()
 
 #: exported name -> the module that defines it (imported on first access)
 _LAZY: dict[str, str] = {

@@ -236,15 +236,7 @@ def appraiser_options() -> Decorator:
             help="Model order N (na = nb = N), as in clpc identify.",
         ),
         click.option(
-            "--parameters-size",
-            "-p",
-            type=click.IntRange(min=2),
-            default=None,
-            hidden=True,
-            help="The paper's name for N + 1 (former option; use --order).",
-        ),
-        click.option(
-            "--window",
+            "--window-size",
             "-w",
             type=click.IntRange(min=2),
             default=201,
@@ -252,7 +244,7 @@ def appraiser_options() -> Decorator:
             help="Lag vectors per LPC window.",
         ),
         click.option(
-            "--cluster",
+            "--cluster-size",
             "-c",
             type=click.IntRange(min=1),
             default=12,
@@ -267,23 +259,13 @@ def appraiser_options() -> Decorator:
             help="Sample time [s] the appraiser works at: an integer multiple of the data's "
             "--dt (the data are low-pass filtered and decimated).",
         ),
-        click.option(
-            "--sample-time",
-            type=click.FloatRange(min=0, min_open=True),
-            default=None,
-            hidden=True,
-            help="Former name of --decimate-to.",
-        ),
         method_option(),
         click.option(
             "--guard/--no-guard",
-            "--gate/--no-gate",
-            "guard",
             default=True,
             show_default=True,
             help="Accept estimates only from trusted windows (enough rows, excited above "
-            "quantization, determined); --no-guard is the paper's appraiser. --gate is the "
-            "former name.",
+            "quantization, determined); --no-guard is the paper's appraiser.",
         ),
     )
 

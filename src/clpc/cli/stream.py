@@ -95,7 +95,7 @@ def stream(settings: StreamSettings) -> None:
 
     \b
     Examples:
-      my_daq | clpc stream --window 201 --cluster 12
+      my_daq | clpc stream --window-size 201 --cluster-size 12
       tail -f log.jsonl | clpc stream --format jsonl --inputs 2 --outputs 2
       cat log.csv | clpc stream -u volt -y pos --time t
     """  # noqa: D301

@@ -123,7 +123,7 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
     """  # noqa: D301
     show = progress if progress is not None else sys.stderr.isatty()
     bar = _progress_bar(settings.record.file, settings.record.skip_rows) if show else None
-    result = track_file(settings, bar, fork_figures=True)
+    result = track_file(settings, bar)
     _print_result(result)
     if settings.save and result.model is None:
         raise click.ClickException(

@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from clpc.appraiser.state_schema import bounded_json
+from clpc._schema import bounded_json
 from clpc.io.errors import DataFileNotFoundError
 from clpc.io.model_schema import (
     FORMAT,

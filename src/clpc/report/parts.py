@@ -14,11 +14,10 @@ from clpc.core.rules import MIN_HELDOUT_FIT
 from clpc.model import LinearModel, fit_verdict
 from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
 from clpc.report.html import Section
-from clpc.report.painter import FigureJob, draw_here
 from clpc.report.summaries import model_summary
 from clpc.report.text import format_fit, format_model_summary
 
-__all__ = ["model_figures", "model_sections", "model_warnings", "settings_section"]
+__all__ = ["draw_model_figures", "model_sections", "model_warnings", "settings_section"]
 
 #: verdict messages that are good news (everything else is shown as a warning)
 #: verdict messages that are evidence or good news, not warnings (kept out of the box)
@@ -87,44 +86,27 @@ def fit_table(summary: Mapping[str, Any]) -> list[list[Any]]:
     return rows
 
 
-#: relative drawing time of one panel of a multi-panel figure (a fit figure of one output
-#: has two; the Bode figure, about 0.2 s, costs 1.5)
-PANEL_COST = 0.5
-
 #: the figures of :func:`model_sections`, in its order
 FIT_PNG, DATA_PNG, STEP_PNG = "fit.png", "data.png", "step.png"
 BODE_PNG, PZ_PNG = "bode.png", "pz.png"
 
 
-def model_figures(
+def draw_model_figures(
     model: LinearModel, out: Path, *, data: Any = None, data_t0: float = 0.0
-) -> list[FigureJob]:
-    """The figures of :func:`model_sections`, as jobs (for :class:`~clpc.report.painter.Painter`).
+) -> None:
+    """Draw the figures of :func:`model_sections`, one after the other.
 
     ``fit.png`` and ``data.png`` (with ``data``), ``step.png``, ``bode.png``, ``pz.png`` in
-    ``out``; ``cost`` is each one's relative drawing time (about :data:`PANEL_COST` per
-    panel of a figure with several).
+    ``out``. Long records are drawn as min/max envelopes (see
+    :data:`clpc.core.figure.MAX_POINTS`), so each figure costs about the same at any length.
     """
-    jobs: list[FigureJob] = []
     if data is not None:
         title = f"the compared {data.n_samples} samples"
-        panels = data.n_inputs + data.n_outputs
-        jobs += [
-            FigureJob(
-                plot_fit, (model, data, out / FIT_PNG), {"t0": data_t0},
-                cost=PANEL_COST * 2 * model.n_outputs,
-            ),
-            FigureJob(
-                plot_data, (data, out / DATA_PNG), {"t0": data_t0, "title": title},
-                cost=PANEL_COST * 0.8 * panels,
-            ),
-        ]  # fmt: skip
-    jobs += [
-        FigureJob(plot_step, (model, out / STEP_PNG), cost=0.5),
-        FigureJob(plot_bode, (model, out / BODE_PNG), cost=1.5),
-        FigureJob(plot_pz, (model, out / PZ_PNG), cost=0.5),
-    ]
-    return jobs
+        plot_fit(model, data, out / FIT_PNG, t0=data_t0)
+        plot_data(data, out / DATA_PNG, t0=data_t0, title=title)
+    plot_step(model, out / STEP_PNG)
+    plot_bode(model, out / BODE_PNG)
+    plot_pz(model, out / PZ_PNG)
 
 
 def model_sections(
@@ -135,7 +117,6 @@ def model_sections(
     data_note: str = "",
     data_t0: float = 0.0,
     summary: Mapping[str, Any] | None = None,
-    draw: bool = True,
 ) -> tuple[list[Section], list[Path]]:
     """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
 
@@ -153,15 +134,12 @@ def model_sections(
         Time of ``data``'s first sample in the whole record (the fit figure's time axis).
     summary : mapping, optional
         :func:`model_summary` of ``model`` on ``data``, when the caller has it already.
-    draw : bool
-        Draw the figures here; ``False`` when the caller draws :func:`model_figures`
-        itself (e.g. in forked processes).
 
     Returns
     -------
     sections : list of Section
     files : list of Path
-        The figures (written when ``draw``).
+        The figures (written).
     """
     summary = model_summary(model, data) if summary is None else summary
     files: list[Path] = []
@@ -206,8 +184,7 @@ def model_sections(
             collapsed=True,
         )
     )
-    if draw:
-        draw_here(model_figures(model, out, data=data, data_t0=data_t0))
+    draw_model_figures(model, out, data=data, data_t0=data_t0)
     return sections, files
 
 

@@ -38,7 +38,7 @@ __all__ = [
 def verdict_text(model: LinearModel, output: int = 0) -> str | None:
     """The identifiability verdict of one output equation in plain words.
 
-    Uses :func:`clpc.verdict.fit_verdict` on the statistics in ``model.info``
+    Uses :func:`clpc.model.verdict.fit_verdict` on the statistics in ``model.info``
     (``determined``, ``n_null``, ``n_input_relations``...) and the evidence a fit stored
     (``heldout``, ``residual_test``); ``None`` for models with neither (e.g. a CLPC
     steady-state model or a hand-built one).

@@ -17,17 +17,8 @@ from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
-from clpc.plotting.traces import trace_panels
 from clpc.report.html import Section, write_html_report
-from clpc.report.painter import FigureJob, Painter
-from clpc.report.parts import (
-    PANEL_COST,
-    fit_warnings,
-    model_figures,
-    model_sections,
-    model_warnings,
-    settings_section,
-)
+from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import model_summary, steady_state, trace_summary
 
 __all__ = ["trace_warnings", "write_track_report"]
@@ -101,7 +92,6 @@ def write_track_report(
     data_t0: float = 0.0,
     steady: tuple[Any, str] | None = None,
     recent: Trace | None = None,
-    painter: Painter | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -130,9 +120,6 @@ def write_track_report(
         (computed from ``trace`` when omitted).
     recent : Trace, optional
         The last updates, unthinned, for the table of the last 20 (default ``trace``).
-    painter : Painter, optional
-        Draws the figures (e.g. in forked processes, :class:`~clpc.report.painter.Painter`);
-        by default they are drawn here, one by one.
 
     Returns
     -------
@@ -142,12 +129,6 @@ def write_track_report(
     out = Path(out_dir)
     model, source = steady_state(trace) if steady is None else steady
     trace_png = out / "trace.png"
-    jobs = [] if model is None else model_figures(model, out, data=data, data_t0=data_t0)
-    title_png = f"CLPC trace: {len(trace)} updates"
-    cost = 0.6 * PANEL_COST * trace_panels(trace)  # 2.1 for one output of order 2
-    jobs.append(FigureJob(plot_trace, (trace, trace_png), {"title": title_png}, cost=cost))
-    painter = Painter(enabled=False) if painter is None else painter
-    painter.submit(jobs)  # drawn meanwhile when the painter forked, else by wait() below
     summary = trace_summary(trace) if summary is None else summary
     warnings = trace_warnings(trace, summary)
     if model is not None:
@@ -171,12 +152,12 @@ def write_track_report(
             data_note=data_note,
             data_t0=data_t0,
             summary=fitted,
-            draw=False,
         )
         more[0].heading = f"Model: {source}"
         sections += more
     else:
         result.text = "The figure of the trace below shows why no estimate was accepted."
+    plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     files.append(trace_png)
     sections.append(
         Section(
@@ -195,6 +176,5 @@ def write_track_report(
     rows += [[row[i] for i in keep] for row in values[-20:]]
     sections.append(Section(f"Last {len(rows) - 1} updates", table=rows, collapsed=True))
     sections.append(settings_section(settings or {}))
-    painter.wait()
     files.append(write_html_report(out / "report.html", title, sections))
     return files

@@ -12,8 +12,6 @@ from clpc.core.checks import (
     check_choice,
     check_int,
     check_positive,
-    resolve_order,
-    same_setting,
 )
 from clpc.data import IOData
 from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
@@ -199,9 +197,9 @@ class AppraiserSettings:
     ----------
     order : int
         Model order ``N`` (``na = nb = N``), at least 1.
-    window : int
+    window_size : int
         Lag vectors per LPC window, at least 2.
-    cluster : int
+    cluster_size : int
         Lag vectors between updates, at least 1.
     nk : int
         Input delay in samples.
@@ -213,32 +211,20 @@ class AppraiserSettings:
     guard : bool
         Accept estimates only from trusted windows (the default; ``False`` is the paper's
         appraiser, see :class:`clpc.CLPC`).
-    parameters_size : int, optional
-        The paper's name for ``order + 1`` (an alias; set to ``order + 1`` after checking).
-    sample_time : float, optional
-        Former name of ``decimate_to`` (an alias; set to ``decimate_to`` after checking).
     """
 
     order: int = 2
-    window: int = 201
-    cluster: int = 12
+    window_size: int = 201
+    cluster_size: int = 12
     nk: int = 0
     decimate_to: float | None = None
     method: Method = "robust"
     guard: bool = True
-    parameters_size: int | None = None
-    sample_time: float | None = None
 
     def __post_init__(self) -> None:
-        explicit = None if self.order == 2 else self.order  # the default is not a choice
-        order = resolve_order(explicit, self.parameters_size, self.order)
-        target = same_setting(self.decimate_to, self.sample_time, "decimate_to", "sample_time")
-        object.__setattr__(self, "order", order)
-        object.__setattr__(self, "parameters_size", order + 1)
-        object.__setattr__(self, "decimate_to", target)
-        object.__setattr__(self, "sample_time", target)
-        check_int(self.window, "window", 2)
-        check_int(self.cluster, "cluster", 1)
+        check_int(self.order, "order", 1)
+        check_int(self.window_size, "window_size", 2)
+        check_int(self.cluster_size, "cluster_size", 1)
         check_int(self.nk, "nk", 0)
         _optional_positive(self.decimate_to, "decimate_to")
         check_choice(self.method, "method", METHODS)
@@ -259,8 +245,8 @@ class AppraiserSettings:
         """
         return CLPC(
             order=self.order,
-            window_size=self.window,
-            cluster_size=self.cluster,
+            window_size=self.window_size,
+            cluster_size=self.cluster_size,
             dt=data_dt if data_dt is not None else (1.0 if self.decimate_to else None),
             decimate_to=self.decimate_to,
             nk=self.nk,

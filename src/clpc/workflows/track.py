@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import importlib
-import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,7 +22,6 @@ from clpc.io import iter_table_chunks, save_model
 from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
-from clpc.report.painter import Painter
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
@@ -269,17 +266,8 @@ class _Run:
     whole: _SummaryTrace = field(default_factory=_SummaryTrace)
 
 
-def _appraise(
-    settings: TrackSettings,
-    trace_file: Path,
-    progress: ChunkFilter | None,
-    after_first: Callable[[], None] | None = None,
-) -> _Run:
-    """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``.
-
-    ``after_first`` is called once the first chunk is appraised (the compiled kernels are
-    loaded then).
-    """
+def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
+    """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``."""
     record = settings.record
     n_in, n_out = len(record.inputs), len(record.outputs)
     clock = _Clock(record) if record.time_col else None
@@ -302,20 +290,9 @@ def _appraise(
                 run = _Run(appraiser, kept, 0, _Tail(factor))
             run.n_raw += values.shape[0]
             run.tail.feed(values[:, : n_in + n_out])
-            if after_first is not None:  # a few rows first: the kernels are loaded after them
-                _push(run, names, values[:_FIRST_ROWS], writer, n_in, n_out)
-                writer.drain()  # no thread inside pyarrow's writer when after_first forks
-                after_first()
-                after_first = None
-                values = values[_FIRST_ROWS:]
             _push(run, names, values, writer, n_in, n_out)
     assert run is not None  # iter_table_chunks raises on a file without rows
     return run
-
-
-#: rows of the first chunk appraised before ``after_first`` (the same trace: ``push`` does
-#: not depend on how the record is cut)
-_FIRST_ROWS = 2000
 
 
 def _push(
@@ -344,14 +321,14 @@ def _chunks(record: RecordSpec, chunk_rows: int, progress: ChunkFilter | None) -
 
 
 def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> None:
-    needed = settings.appraiser.window + run.appraiser.structure.max_lag
+    needed = settings.appraiser.window_size + run.appraiser.structure.max_lag
     if run.appraiser.n_samples < needed or not run.kept.seen:
         trace_file.unlink(missing_ok=True)
         raise DataError(
             f"the record is too short for the window: {run.appraiser.n_samples} sample(s) "
-            f"(of {run.n_raw} read) but --window {settings.appraiser.window} with "
+            f"(of {run.n_raw} read) but --window-size {settings.appraiser.window_size} with "
             f"--order {settings.appraiser.order} needs at least {needed}; "
-            "use a smaller --window or a longer record."
+            "use a smaller --window-size or a longer record."
         )
 
 
@@ -379,51 +356,7 @@ def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
     return {"data": data, "data_note": note, "data_t0": t0}
 
 
-#: the report's heavy imports (matplotlib, about 0.5 s), loaded in a thread while the record
-#: is read and appraised when no painter process does it: pyarrow's reader, the trace
-#: writer and the compiled kernel run without holding the GIL
-_REPORT_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
-
-
-def _import_quietly(names: tuple[str, ...]) -> None:
-    for name in names:
-        try:
-            importlib.import_module(name)
-        except Exception:  # the report's own import says what is missing
-            return
-
-
-def _load_numba() -> None:
-    """Import numba and set up its machinery (0.3 s, once per process) on a small kernel."""
-    try:
-        from clpc.core.polynomials import stable_many
-
-        stable_many(np.array([1.0, -0.5]))  # loaded from numba's cache after the first run
-    except Exception:  # the appraiser's own call says what is wrong
-        return
-
-
-def _prefetch(names: tuple[str, ...], numba: bool = False) -> threading.Thread:
-    """Import ``names`` (and load numba) in a background thread, joined before they are used.
-
-    The main thread meanwhile reads and appraises: pyarrow's reader, the trace writer and
-    the compiled kernel release the GIL.
-    """
-
-    def work() -> None:
-        if numba:
-            _load_numba()
-        _import_quietly(names)
-
-    thread = threading.Thread(target=work, name="clpc-prefetch")
-    thread.daemon = True
-    thread.start()
-    return thread
-
-
-def track_file(
-    settings: TrackSettings, progress: ChunkFilter | None = None, *, fork_figures: bool = False
-) -> TrackResult:
+def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> TrackResult:
     """Run the CLPC appraiser over a record (read in chunks); write a trace and a report.
 
     Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
@@ -439,11 +372,6 @@ def track_file(
     progress : callable, optional
         Wraps the iterator of chunks ``(names, values)`` read from the file (once the file
         is open) and yields them on, e.g. to show a progress bar.
-    fork_figures : bool
-        Draw the report's figures in forked processes (:class:`clpc.report.painter.Painter`,
-        Linux, or POSIX with ``CLPC_PAINTER=1``; ``CLPC_PAINTER=0`` turns it off): one
-        imports matplotlib while the record is appraised, then two draw on the machine's
-        cores. ``clpc track`` does.
 
     Returns
     -------
@@ -465,24 +393,11 @@ def track_file(
         )
     out = Path(settings.out_dir)
     trace_file = out / f"trace.{settings.fmt}"
-    with Painter(enabled=None if fork_figures else False) as painter:
-        # numba is loaded in a thread while the first chunk is read; the painter is forked
-        # after it (and after the first rows: the kernels are loaded) and imports matplotlib
-        # while the record is appraised. Without it, the thread imports matplotlib as well.
-        prefetch = _prefetch(() if painter.enabled else _REPORT_MODULES, numba=True)
-
-        def fork_painter() -> None:
-            prefetch.join()  # no fork while a thread is inside numba's compiler
-            painter.start()
-
-        try:
-            run = _appraise(settings, trace_file, progress, fork_painter)
-        finally:
-            prefetch.join()  # no import of the same modules from two threads at once
-        return _finish(settings, run, trace_file, painter)
+    run = _appraise(settings, trace_file, progress)
+    return _finish(settings, run, trace_file)
 
 
-def _finish(settings: TrackSettings, run: _Run, trace_file: Path, painter: Painter) -> TrackResult:
+def _finish(settings: TrackSettings, run: _Run, trace_file: Path) -> TrackResult:
     """The report and the saved model of an appraised record."""
     out = Path(settings.out_dir)
     _check_long_enough(run, settings, trace_file)
@@ -506,7 +421,6 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, painter: Paint
         summary=summary,
         steady=(model, source),
         recent=run.whole.last,
-        painter=painter,
         **_report_data(run, trace),
     )
     files = [trace_file, *report]

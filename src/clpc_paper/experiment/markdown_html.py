@@ -1,4 +1,4 @@
-r"""The small Markdown subset the reports emit, as HTML (no dependency).
+r"""The small Markdown subset of the experiment's ``report.md``, as HTML (no dependency).
 
 Handles what :mod:`clpc_paper.experiment` writes into ``report.md``: ``#``/``##`` headings,
 paragraphs, pipe tables (``\|`` escapes a bar inside a cell), images on their own line
