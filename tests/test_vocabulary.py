@@ -29,15 +29,9 @@ def _run(*args):
     return CliRunner().invoke(cli, [str(a) for a in args])
 
 
-def test_lpc_parameters_size_is_an_alias_of_order(record):
-    # still accepted by clpc.LPC and clpc.CLPC (clpc/lpc/estimator.py, clpc/appraiser/facade.py
-    # are outside issue 24's house cleaning): gone from the workflows and the command line
-    u, y = record
-    a = clpc.LPC(order=3).fit(u, y)
-    b = clpc.LPC(parameters_size=4).fit(u, y)
-    np.testing.assert_array_equal(np.atleast_2d(a.theta), np.atleast_2d(b.theta))
-    with pytest.raises(ValueError, match="order and parameters_size name one setting"):
-        clpc.LPC(order=3, parameters_size=3).fit(u, y)
+def test_lpc_has_one_name_for_its_order():
+    with pytest.raises(TypeError, match="parameters_size"):
+        clpc.LPC(parameters_size=4)
 
 
 def test_clpc_order_equals_parameters_size(record):

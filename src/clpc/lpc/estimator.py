@@ -18,7 +18,6 @@ import numpy as np
 from scipy.linalg import lapack
 
 from clpc.core import rules
-from clpc.core.checks import resolve_order
 from clpc.data import DataError, IOData, as_iodata
 from clpc.data.samples import check_spread
 from clpc.lpc import assessment
@@ -54,7 +53,7 @@ def lpc_solve(
     Parameters
     ----------
     matrices : ndarray, shape (k, n_rows, p)
-        Lag matrices (paper eq. 36), e.g. from :func:`clpc.regressors.regressors`.
+        Lag matrices (paper eq. 36), e.g. from :func:`clpc.lpc.regressors.regressors`.
     n_output_cols, blocks, method, noise_cov, rule, scaling
         See :func:`clpc.lpc.solve.solve_scatter`.
 
@@ -166,7 +165,7 @@ class LPC:
     Parameters
     ----------
     order : int
-        The paper's ``N`` (``parameters_size - 1``): ``na = nb = order``. Default 2.
+        The paper's ``N`` (its ``parameters_size`` is ``N + 1``): ``na = nb = order``. Default 2.
     na, nb : int, optional
         Separate output / input orders (override ``order``): ``A`` has ``na + 1``
         coefficients ``a0..a_na`` and each ``B`` has ``nb + 1``, ``b0..b_nb`` applied to
@@ -215,9 +214,6 @@ class LPC:
         (``info["heldout"]``, ``info["residual_test"]``, :meth:`LinearModel.assess`): the
         fit of a refit on the first two thirds scored on the last third, and the residual
         tests.
-    parameters_size : int, optional
-        The paper's name for ``order + 1`` (an alias of ``order``; an ``order`` other than
-        the default given with it must agree).
 
     Notes
     -----
@@ -237,14 +233,10 @@ class LPC:
     cancel: bool = True
     uncertainty: bool = True
     assess: bool = True
-    parameters_size: int | None = None
 
     def structure(self) -> Structure:
         """The :class:`Structure` these settings describe."""
-        # order's default (2) cannot be told from an explicit 2: only another order conflicts
-        explicit = None if self.order == 2 else self.order
-        order = resolve_order(explicit, self.parameters_size, self.order)
-        return Structure.from_settings(order, self.na, self.nb, self.nk)
+        return Structure.from_settings(self.order, self.na, self.nb, self.nk)
 
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
         """Identify the model from a record.

@@ -256,7 +256,7 @@ class LinearModel:
         )
 
     def verdict(self, output: int = 0) -> Any:
-        """Identifiability of the fit in plain words (:func:`clpc.verdict.fit_verdict`)."""
+        """Identifiability of the fit in plain words (:func:`clpc.model.verdict.fit_verdict`)."""
         from clpc.model.verdict import fit_verdict
 
         return fit_verdict(self, output)

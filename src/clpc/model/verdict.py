@@ -1,6 +1,6 @@
 """Identifiability verdicts in plain words, for a fit and for every cluster of a trace.
 
-The numbers behind them come from the solve (:mod:`clpc.solve`): the dimension of the
+The numbers behind them come from the solve (:mod:`clpc.lpc.solve`): the dimension of the
 near-null subspace the solution was taken from (``n_null``), the near-null relations that
 involve almost no output (``n_input_relations``: the input alone satisfies them, so it is not
 persistently exciting of the model's order), the separation of the solution's eigenvalue from
