@@ -13,15 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from clpc.data import as_iodata
-from clpc.lpc import assessment
-from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
-from clpc.lpc.uncertainty import (
-    least_squares_covariance,
-    monic_map,
-    with_covariance,
-    without_covariance,
-)
+from clpc.lpc.problem import Covariance, FitProblem
+from clpc.lpc.regressors import MimoMode, Structure
+from clpc.lpc.uncertainty import least_squares_covariance, monic_map
 from clpc.model import LinearModel
 
 __all__ = ["ARX", "simulate_arx"]
@@ -58,14 +52,9 @@ class ARX:
 
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
         """Least-squares fit; returns a :class:`LinearModel` (``theta`` unit norm, a0 > 0)."""
-        data = as_iodata(u, y, dt)
-        structure = self.structure()
-        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
-        check_mode(mode, data.n_inputs, data.n_outputs)
-        n_blocks = data.n_inputs if mode == "miso" else 1
-        p = structure.n_params(n_blocks)
-        data.require_samples(structure.max_lag + p + 1, f"An ARX fit with {p} parameters")
-        mats = regressors(data, structure, mode)
+        problem = FitProblem.prepare(self, (u, y, dt), "An ARX fit")
+        data, structure, mode = problem.data, problem.structure, problem.mode
+        mats = problem.regressors()
         mean = mats.mean(axis=1)
         thetas = np.empty((mats.shape[0], mats.shape[2]))
         covs, dofs, no_cov = [], [], ""
@@ -86,22 +75,12 @@ class ARX:
                 dofs.append(dof)
         thetas /= np.linalg.norm(thetas, axis=1, keepdims=True)
         c = np.einsum("kp,kp->k", mean, thetas)
-        model = LinearModel(
-            theta=thetas,
-            structure=structure,
-            n_inputs=data.n_inputs,
-            mode=mode,
-            c=c,
-            dt=data.dt,
-            input_names=data.input_names,
-            output_names=data.output_names,
-            info={"method": "least-squares"},
-        )
+        covariance = None
         if no_cov:
-            model = without_covariance(model, no_cov)
+            covariance = Covariance(note=no_cov)
         elif self.uncertainty:
-            model = with_covariance(model, np.stack(covs), np.array(dofs), "least squares")
-        return assessment.with_record(model, data, self)
+            covariance = Covariance(np.stack(covs), np.array(dofs), "least squares")
+        return problem.model(self, thetas, c, {"method": "least-squares"}, covariance)
 
 
 def simulate_arx(den: Any, num: Any, u: Any, noise: Any | None = None) -> np.ndarray:

@@ -18,14 +18,15 @@ import numpy as np
 from scipy.linalg import lapack
 
 from clpc.core import rules
-from clpc.data import DataError, IOData, as_iodata
+from clpc.data import DataError, IOData
 from clpc.data.samples import check_spread
-from clpc.lpc import assessment
+from clpc.lpc.problem import FitProblem
 from clpc.lpc.reduction import reduce_model
-from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, regressors
+from clpc.lpc.regressors import MimoMode, Structure, regressors
 from clpc.lpc.solve import RobustRule, SolveResult, noise_covariance, solve_scatter
 from clpc.lpc.uncertainty import covariance_entries, jackknife_blocks, lpc_jackknife, monic_map
 from clpc.model import LinearModel, ModelError
+from clpc.model.structure import input_blocks
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "r_factor", "structure_blocks"]
 
@@ -260,16 +261,11 @@ class LPC:
         DataError
             Invalid data, too few samples, or a record in which nothing varies.
         """
-        data = as_iodata(u, y, dt)
+        problem = FitProblem.prepare(self, (u, y, dt), "An LPC fit")
+        data, structure, n_blocks = problem.data, problem.structure, problem.n_blocks
         if self.noise_cov is None and self.noise_ratio is None:
             check_spread(data.u, data.y, self.scaling)
-        structure = self.structure()
-        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
-        check_mode(mode, data.n_inputs, data.n_outputs)
-        n_blocks = data.n_inputs if mode == "miso" else 1
-        p = structure.n_params(n_blocks)
-        data.require_samples(structure.max_lag + p + 1, f"An LPC fit with {p} parameters")
-        mats = regressors(data, structure, mode)
+        mats = problem.regressors()
         rule = self.rule or RobustRule()
         res = lpc_solve(
             mats,
@@ -286,29 +282,18 @@ class LPC:
         info["scaling"] = (
             self.scaling if self.noise_cov is None and self.noise_ratio is None else "noise"
         )
-        model = LinearModel(
-            theta=res.theta,
-            structure=structure,
-            n_inputs=data.n_inputs,
-            mode=mode,
-            c=res.c,
-            dt=data.dt,
-            input_names=data.input_names,
-            output_names=data.output_names,
-            info=info,
-        )
-        model = reduce_model(model, data) if self.cancel else model
         covariance = None
         if self.uncertainty:
             covariance = lambda fitted: self._covariance_entries(fitted, data, rule)  # noqa: E731
-        return assessment.with_record(model, data, self, covariance)
+        model = problem.model(self, res.theta, res.c, info, covariance)
+        return reduce_model(model, data) if self.cancel else model
 
     def _covariance_entries(
         self, model: LinearModel, data: IOData, rule: RobustRule
     ) -> dict[str, Any]:
         """The block-jackknife covariance of this solve at ``model``'s structure (entries)."""
         s, mode = model.structure, model.mode
-        n_blocks_in = data.n_inputs if mode == "miso" else 1
+        n_blocks_in = input_blocks(mode, data.n_inputs)
         mats = regressors(data, s, mode)  # type: ignore[arg-type]
         groups = jackknife_blocks(mats.shape[1], mats.shape[2])
         if not groups:
@@ -338,7 +323,7 @@ class LPC:
         how = f"block jackknife over {groups} segments"
         if model.info.get("cancelled"):
             how += " (LPC solve at the reduced order)"
-        return covariance_entries(model, cov, groups - 1, how)
+        return covariance_entries(cov, groups - 1, how)
 
 
 def _raise_if_degenerate(res: SolveResult, data: IOData) -> None:

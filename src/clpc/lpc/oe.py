@@ -34,15 +34,15 @@ from typing import Any
 import numpy as np
 
 from clpc.core.polynomials import cancel_common_factors
-from clpc.data import DataError, IOData, as_iodata
-from clpc.lpc import assessment
+from clpc.data import DataError, IOData
 from clpc.lpc.arx import ARX
 from clpc.lpc.estimator import LPC
+from clpc.lpc.problem import Covariance, FitProblem
 from clpc.lpc.reduction import KEEP_FIT_POINTS
 from clpc.lpc.reflection import MAX_KAPPA, reflection_from_poly
-from clpc.lpc.regressors import MimoMode, Structure, check_mode, default_mode, lagged
+from clpc.lpc.regressors import MimoMode, Structure, lagged
 from clpc.lpc.simulation_error import SEGMENTS, SimulationError
-from clpc.lpc.uncertainty import monic_map, with_covariance, without_covariance
+from clpc.lpc.uncertainty import monic_map
 from clpc.model import LinearModel, ModelError
 
 __all__ = ["OE"]
@@ -157,13 +157,8 @@ class OE:
             raise ValueError(
                 f"starts must name 'arx' and/or 'lpc' (or pass initial=); got {self.starts!r}."
             )
-        data = as_iodata(u, y, dt)
-        structure = self.structure()
-        mode = self.mimo or default_mode(data.n_inputs, data.n_outputs)
-        check_mode(mode, data.n_inputs, data.n_outputs)
-        n_blocks = data.n_inputs if mode == "miso" else 1
-        p = structure.n_params(n_blocks)
-        data.require_samples(structure.max_lag + p + 2, f"An OE fit with {p} parameters")
+        problem = FitProblem.prepare(self, (u, y, dt), "An OE fit", extra_samples=2)
+        data, structure, mode = problem.data, problem.structure, problem.mode
         starts = self._starts(data, structure, mode)
         thetas, cs = [], []
         info: dict[str, Any] = {"method": "output-error", "noise_model": "output-error"}
@@ -232,24 +227,14 @@ class OE:
         for key in ("start", "cost", "nfev", "success", "cancelled"):
             info[key] = np.array([row[key] for row in per_output])
         info["start_costs"] = [row["start_costs"] for row in per_output]
-        model = LinearModel(
-            theta=np.array(thetas),
-            structure=structure,
-            n_inputs=data.n_inputs,
-            mode=mode,
-            c=np.array(cs),
-            dt=data.dt,
-            input_names=data.input_names,
-            output_names=data.output_names,
-            info=info,
-        )
+        covariance = None
         if no_cov:
-            model = without_covariance(model, no_cov)
+            covariance = Covariance(note=no_cov)
         elif self.uncertainty:
             cov = np.stack([c for c, _ in covs])
             dof = np.array([d for _, d in covs])
-            model = with_covariance(model, cov, dof, "Jacobian of the simulation error")
-        return assessment.with_record(model, data, self)
+            covariance = Covariance(cov, dof, "Jacobian of the simulation error")
+        return problem.model(self, np.array(thetas), np.array(cs), info, covariance)
 
     def _starts(self, data: IOData, structure: Structure, mode: str) -> dict[str, LinearModel]:
         """The least-squares and LPC fits (and ``initial``) that start the search."""

@@ -18,7 +18,14 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from clpc.data import IOData
-from clpc.model.structure import MimoMode, Structure, check_mode, column_labels, default_mode
+from clpc.model.structure import (
+    MimoMode,
+    Structure,
+    check_mode,
+    column_labels,
+    default_mode,
+    input_blocks,
+)
 
 __all__ = [
     "MimoMode",
@@ -160,7 +167,7 @@ def regressors(data: IOData, structure: Structure, mode: MimoMode) -> np.ndarray
         f"A model with na={structure.na}, nb={structure.nb}, nk={structure.nk}",
     )
     start, n_out, n_rows = structure.max_lag, data.n_outputs, data.n_samples - structure.max_lag
-    n_in = data.n_inputs if mode == "miso" else 1
+    n_in = input_blocks(mode, data.n_inputs)
     na1, nb1 = structure.na + 1, structure.nb + 1
     # each out[j] column-major (Fortran order): a column is one contiguous copy of a signal
     out = np.empty((n_out, na1 + n_in * nb1, n_rows)).transpose(0, 2, 1)

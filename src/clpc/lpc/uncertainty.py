@@ -69,35 +69,34 @@ def monic_map(structure: Structure, n_inputs: int, mode: str, output: int = 0) -
     return out
 
 
-def covariance_entries(
-    model: LinearModel, cov: np.ndarray, dof: Any, method: str
-) -> dict[str, Any]:
+def covariance_entries(cov: np.ndarray, dof: Any, method: str) -> dict[str, Any]:
     """The ``info`` entries of a covariance: ``covariance``, ``covariance_dof``, ``_method``.
 
     Parameters
     ----------
-    model : LinearModel
-        The model the covariance belongs to (for its shape).
     cov : ndarray, shape (n_outputs, q, q)
-        Covariance of ``np.r_[den[1:], num]`` per output.
+        Covariance of ``np.r_[den[1:], num]`` per output (symmetrised here).
     dof : float or ndarray, shape (n_outputs,)
         Degrees of freedom of the variance estimate.
     method : str
         How the covariance was obtained (shown by :meth:`LinearModel.summary`).
     """
-    q = model.n_inputs * (model.structure.nk + model.structure.nb + 1) + model.structure.na
-    cov = np.asarray(cov, dtype=np.float64).reshape(model.n_outputs, q, q)
+    cov = np.asarray(cov, dtype=np.float64)
+    if cov.ndim != 3 or cov.shape[1] != cov.shape[2]:
+        raise ValueError(f"cov must have shape (n_outputs, q, q); got {cov.shape}.")
     return {
         "covariance": 0.5 * (cov + np.swapaxes(cov, 1, 2)),
-        "covariance_dof": np.broadcast_to(np.asarray(dof, float), (model.n_outputs,)).copy(),
+        "covariance_dof": np.broadcast_to(np.asarray(dof, float), cov.shape[:1]).copy(),
         "covariance_method": method,
     }
 
 
 def with_covariance(model: LinearModel, cov: np.ndarray, dof: Any, method: str) -> LinearModel:
     """``model`` with the entries of :func:`covariance_entries` in its ``info``."""
+    q = model.n_inputs * (model.structure.nk + model.structure.nb + 1) + model.structure.na
+    cov = np.asarray(cov, dtype=np.float64).reshape(model.n_outputs, q, q)
     info = {k: v for k, v in model.info.items() if k != "covariance_note"}
-    info.update(covariance_entries(model, cov, dof, method))
+    info.update(covariance_entries(cov, dof, method))
     return replace(model, info=info)
 
 

@@ -15,7 +15,14 @@ from typing import Literal
 from clpc.core.checks import check_int
 from clpc.data import DataError
 
-__all__ = ["MimoMode", "Structure", "check_mode", "column_labels", "default_mode"]
+__all__ = [
+    "MimoMode",
+    "Structure",
+    "check_mode",
+    "column_labels",
+    "default_mode",
+    "input_blocks",
+]
 
 MimoMode = Literal["siso", "paired", "miso"]
 
@@ -91,6 +98,23 @@ def check_mode(mode: str, n_inputs: int, n_outputs: int) -> None:
 def default_mode(n_inputs: int, n_outputs: int) -> MimoMode:
     """``"siso"`` for one input and one output, otherwise ``"miso"``."""
     return "siso" if n_inputs == 1 and n_outputs == 1 else "miso"
+
+
+def input_blocks(mode: str, n_inputs: int) -> int:
+    """Input blocks of one lag vector: every input for ``"miso"``, one otherwise.
+
+    The one place this rule lives: ``"miso"`` puts every input's lags in each equation's lag
+    vector; ``"siso"`` and ``"paired"`` (the paper's eqs. 35-38) one input, input ``j`` for
+    output ``j``.
+
+    Parameters
+    ----------
+    mode : {"siso", "paired", "miso"}
+        MIMO structure.
+    n_inputs : int
+        Inputs of the record.
+    """
+    return n_inputs if mode == "miso" else 1
 
 
 def column_labels(
