@@ -56,7 +56,17 @@ def fit_percent(y: Any, y_hat: Any) -> Any:
 
 
 def rmse(y: Any, y_hat: Any) -> Any:
-    """Root-mean-square error, same units as ``y``; per channel for 2-D input."""
+    """Root-mean-square error, same units as ``y``; per channel for 2-D input.
+
+    Parameters
+    ----------
+    y, y_hat : array_like, shape (T,) or (T, n_channels)
+        Measured and modelled signals (same shape, finite).
+
+    Returns
+    -------
+    float or ndarray, shape (n_channels,)
+    """
     a, b, one = _pair(y, y_hat)
     return _out(np.sqrt(np.mean((a - b) ** 2, axis=0)), one)
 
@@ -66,6 +76,15 @@ def vaf(y: Any, y_hat: Any) -> Any:
 
     A constant ``y`` gives 100 when the error is constant too, else ``-inf`` (as
     :func:`fit_percent`).
+
+    Parameters
+    ----------
+    y, y_hat : array_like, shape (T,) or (T, n_channels)
+        Measured and modelled signals (same shape, finite).
+
+    Returns
+    -------
+    float or ndarray, shape (n_channels,)
     """
     a, b, one = _pair(y, y_hat)
     var = np.var(a, axis=0)
@@ -84,6 +103,22 @@ def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
 
     For integrating plants (a motor from torque to position) a free-run simulation drifts
     and says little; the ``k``-step fit measures what the model knows about the dynamics.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model whose :meth:`~clpc.LinearModel.predict` is scored.
+    u : array_like, shape (T,) or (T, n_inputs)
+        Input samples.
+    y : array_like, shape (T,) or (T, n_outputs)
+        Measured outputs (predicted from and scored against).
+    k : int
+        Prediction horizon in samples (>= 1, default 1).
+
+    Returns
+    -------
+    float or ndarray, shape (n_outputs,)
+        Fit % (:func:`fit_percent`): a float for 1-D ``y``, else one per output.
     """
     y_arr = np.asarray(y, dtype=np.float64)
     y_hat = model.predict(u, y_arr, k=k)

@@ -16,6 +16,16 @@ def jsonable(x: Any) -> Any:
 
     Mappings become dicts with string keys, arrays and tuples lists, numpy scalars Python
     scalars, complex numbers ``[real, imag]``; anything else is returned as it is.
+
+    Parameters
+    ----------
+    x : object
+        The value (a number, array, mapping, sequence...).
+
+    Returns
+    -------
+    object
+        ``x`` with numpy types replaced, nested containers converted.
     """
     if isinstance(x, Mapping):
         return {str(k): jsonable(v) for k, v in x.items()}

@@ -157,6 +157,16 @@ class IOData:
     def concat(cls, records: Sequence[IOData]) -> IOData:
         """Several experiments as one record (their boundaries kept, see :meth:`split`).
 
+        Parameters
+        ----------
+        records : sequence of IOData
+            The experiments, in order; same sample time and same channel names.
+
+        Returns
+        -------
+        IOData
+            The samples stacked, with one entry of ``experiments`` per record's experiment.
+
         Raises
         ------
         DataError
@@ -194,7 +204,17 @@ class IOData:
 
     # ------------------------------------------------------------ preprocessing
     def detrend(self, kind: str = "constant") -> IOData:
-        """Remove each channel's mean (``"constant"``) or line (``"linear"``) per experiment."""
+        """Remove each channel's mean (``"constant"``) or line (``"linear"``) per experiment.
+
+        Parameters
+        ----------
+        kind : {"constant", "linear"}
+            Remove the mean (default) or the least-squares straight line.
+
+        Returns
+        -------
+        IOData
+        """
         both = processing.detrend_parts(np.hstack([self.u, self.y]), self.experiments, kind)
         return self._with(both[:, : self.n_inputs], both[:, self.n_inputs :])
 
@@ -207,8 +227,24 @@ class IOData:
     ) -> IOData:
         """Butterworth-filter every channel (see :func:`clpc.data.processing.filter_parts`).
 
-        ``cutoff`` [Hz]; ``zero_phase=True`` (default) filters forwards and backwards, so
-        the filter adds no delay (a causal filter would shift the estimated delay ``nk``).
+        ``zero_phase=True`` (default) filters forwards and backwards, so the filter adds no
+        delay (a causal filter would shift the estimated delay ``nk``).
+
+        Parameters
+        ----------
+        cutoff : float or (float, float)
+            Cut-off frequency [Hz] (two for ``"bandpass"``/``"bandstop"``), below the
+            Nyquist frequency ``1 / (2 dt)``.
+        btype : {"lowpass", "highpass", "bandpass", "bandstop"}
+            Filter type; default ``"lowpass"``.
+        order : int
+            Butterworth order (default 4; doubled in effect by ``zero_phase``).
+        zero_phase : bool
+            Filter forwards and backwards (no delay, default) instead of causally.
+
+        Returns
+        -------
+        IOData
         """
         both = processing.filter_parts(
             np.hstack([self.u, self.y]), self.experiments, self.dt, cutoff, btype, order, zero_phase
@@ -216,7 +252,18 @@ class IOData:
         return self._with(both[:, : self.n_inputs], both[:, self.n_inputs :])
 
     def resample(self, dt: float) -> IOData:
-        """The record at sample time ``dt`` [s] (polyphase, anti-aliased; per experiment)."""
+        """The record at sample time ``dt`` [s] (polyphase, anti-aliased; per experiment).
+
+        Parameters
+        ----------
+        dt : float
+            New sample time [s], > 0; ``self.dt / dt`` must be a fraction ``up / down``
+            with ``down <= 1000``.
+
+        Returns
+        -------
+        IOData
+        """
         new_dt = check_dt(dt)
         both, parts = processing.resample_parts(
             np.hstack([self.u, self.y]), self.experiments, self.dt, new_dt
@@ -244,10 +291,23 @@ class IOData:
         dt: float | None = None,
         experiment: str | None = None,
     ) -> IOData:
-        """A record from DataFrame columns (``experiment``: a column numbering experiments).
+        """A record from DataFrame columns; :meth:`to_frame` round-trips.
 
-        ``dt`` defaults to the frame's ``time`` column's mean step when it has one, else 1;
-        :meth:`to_frame` round-trips.
+        Parameters
+        ----------
+        frame : pandas.DataFrame
+            The samples, one column per channel.
+        inputs, outputs : str or sequence of str
+            Names of the input and output columns (also the channel names).
+        dt : float, optional
+            Sample time [s]; default the ``time`` column's mean step (in the first
+            experiment) when the frame has one, else 1.
+        experiment : str, optional
+            A column labelling the experiments; each change of label starts a new one.
+
+        Returns
+        -------
+        IOData
         """
         ins = [inputs] if isinstance(inputs, str) else list(inputs)
         outs = [outputs] if isinstance(outputs, str) else list(outputs)
@@ -270,17 +330,43 @@ class IOData:
         return cls(frame[ins], frame[outs], 1.0 if dt is None else dt, ins, outs, parts)
 
     def plot(self, path: Any = None, *, title: str | None = None, ax: Any = None) -> Any:
-        """Plot every channel against time; returns the figure (needs matplotlib).
+        """Plot every channel against time (needs matplotlib).
 
-        See :func:`clpc.data.plot.plot_iodata` (``path`` also writes a PNG, ``ax`` takes
-        ``n_inputs + n_outputs`` axes).
+        See :func:`clpc.data.plot.plot_iodata`.
+
+        Parameters
+        ----------
+        path : str or path-like, optional
+            Also write the figure as PNG here (parent folders are created).
+        title : str, optional
+            Figure title (default: the sample count and sample time).
+        ax : sequence of matplotlib Axes, optional
+            ``n_inputs + n_outputs`` axes to draw on; default: a new figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
         """
         from clpc.data.plot import plot_iodata
 
         return plot_iodata(self, path, title=title, ax=ax)
 
     def require_samples(self, needed: int, why: str) -> None:
-        """Raise :class:`DataError` unless at least ``needed`` samples are present."""
+        """Raise :class:`DataError` unless at least ``needed`` samples are present.
+
+        Parameters
+        ----------
+        needed : int
+            Minimum number of samples.
+        why : str
+            What needs them, starting the error message (e.g. ``"An ARX fit with 5
+            parameters"``).
+
+        Raises
+        ------
+        DataError
+            The record has fewer than ``needed`` samples.
+        """
         if self.n_samples < needed:
             raise DataError(
                 f"{why} needs at least {needed} samples; the record has {self.n_samples}. "
@@ -302,6 +388,9 @@ def _experiments(given: Sequence[int] | None, n: int) -> tuple[int, ...]:
 def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: Any) -> IOData:
     """Return ``u`` if it is an :class:`IOData`, else build one from ``u, y, dt``.
 
+    Further keyword arguments (``input_names``, ``output_names``) are passed to
+    :class:`IOData`.
+
     Parameters
     ----------
     u : IOData, sequence of IOData, or array_like, shape (n_samples,) or (n_samples, n_inputs)
@@ -311,8 +400,6 @@ def as_iodata(u: Any, y: Any | None = None, dt: float | None = None, **names: An
         Output samples; required unless ``u`` is an :class:`IOData`.
     dt : float, optional
         Sample time [s]; overrides the record's when given.
-    **names
-        ``input_names`` / ``output_names`` passed to :class:`IOData`.
 
     Returns
     -------

@@ -23,7 +23,22 @@ _HERE = Path(__file__).resolve().parent
 
 @dataclass(frozen=True)
 class Dataset:
-    """Where a record lives and how its columns split into inputs and outputs."""
+    """Where a record lives and how its columns split into inputs and outputs.
+
+    Attributes
+    ----------
+    file : str
+        CSV file name, beside this module.
+    inputs, outputs : tuple of str
+        Column names of the inputs and outputs (of the estimation part).
+    dt : float or None
+        Sample time [s]; ``None`` when the source gives none (loaded with ``dt = 1``).
+    description : str
+        One line: the plant and what drives what.
+    validation : (tuple of str, tuple of str) or None
+        Input and output column names of a separate validation record, if the source
+        splits it (default ``None``).
+    """
 
     file: str
     inputs: tuple[str, ...]

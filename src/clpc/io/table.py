@@ -115,6 +115,15 @@ class Table:
     def index(self, key: ColumnKey) -> int:
         """0-based position of column ``key`` (a name or an integer index).
 
+        Parameters
+        ----------
+        key : str or int
+            Column name, or index (negative counts from the end).
+
+        Returns
+        -------
+        int
+
         Raises
         ------
         DataError
@@ -123,14 +132,26 @@ class Table:
         return resolve_column(self.names, key, self.source or "the table")
 
     def column(self, key: ColumnKey) -> np.ndarray:
-        """The values of column ``key`` (name or index), shape (n_rows,)."""
+        """The values of column ``key`` (name or index), shape (n_rows,).
+
+        Parameters
+        ----------
+        key : str or int
+            Column name, or index (as :meth:`index`).
+        """
         return self.data[:, self.index(key)]
 
     def __getitem__(self, key: ColumnKey) -> np.ndarray:
         return self.column(key)
 
     def row_label(self, row: int) -> str:
-        """Where 0-based row ``row`` is in the source: ``"line 12"`` (text) or ``"row 11"``."""
+        """Where 0-based row ``row`` is in the source: ``"line 12"`` (text) or ``"row 11"``.
+
+        Parameters
+        ----------
+        row : int
+            0-based row index in the table.
+        """
         if self._lines is not None:
             return f"line {int(self._lines[row])}"
         return f"{self._unit} {self._first + int(row)}"

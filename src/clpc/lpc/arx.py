@@ -51,7 +51,23 @@ class ARX:
         return Structure.from_settings(self.order, self.na, self.nb, self.nk)
 
     def fit(self, u: Any, y: Any | None = None, dt: float | None = None) -> LinearModel:
-        """Least-squares fit; returns a :class:`LinearModel` (``theta`` unit norm, a0 > 0)."""
+        """Least-squares fit; returns a :class:`LinearModel` (``theta`` unit norm, a0 > 0).
+
+        Parameters
+        ----------
+        u : IOData or array_like, shape (T,) or (T, n_inputs)
+            The record, or its inputs.
+        y : array_like, shape (T,) or (T, n_outputs), optional
+            Outputs (when ``u`` is not an :class:`IOData`).
+        dt : float, optional
+            Sample time [s] (when ``u`` is not an :class:`IOData`).
+
+        Returns
+        -------
+        LinearModel
+            With the classical covariance when ``uncertainty``; the held-out assessment is
+            offered on demand when ``assess``.
+        """
         problem = FitProblem.prepare(self, (u, y, dt), "An ARX fit")
         data, structure, mode = problem.data, problem.structure, problem.mode
         mats = problem.regressors()

@@ -228,7 +228,17 @@ def _by_validation(
 
 @dataclass(frozen=True)
 class DelaySelection:
-    """Held-out ``k``-step fit % per input delay and the chosen delay."""
+    """Held-out ``k``-step fit % per input delay and the chosen delay.
+
+    Attributes
+    ----------
+    delays : ndarray of int, shape (n_delays,)
+        The candidate input delays ``nk`` [samples], ascending.
+    validation_fit : ndarray, shape (n_delays,)
+        Held-out ``k``-step prediction fit [%] of each candidate (all outputs together).
+    best : int
+        The chosen delay [samples]: the smallest within ``parsimony`` points of the best fit.
+    """
 
     delays: np.ndarray
     validation_fit: np.ndarray

@@ -193,11 +193,32 @@ class LinearModel:
 
     # ----------------------------------------------------------------- analysis
     def poles(self, output: int = 0) -> np.ndarray:
-        """Poles (roots of ``z^na A(z)``) of output ``output``'s equation."""
+        """Poles (roots of ``z^na A(z)``) of output ``output``'s equation.
+
+        Parameters
+        ----------
+        output : int
+            Output index (default 0).
+
+        Returns
+        -------
+        ndarray of complex, shape (na,)
+        """
         return np.roots(self.denominators[output])
 
     def zeros(self, output: int = 0, input: int = 0) -> np.ndarray:
-        """Finite zeros of ``G_{output,input}(z)`` (leading zero coefficients dropped)."""
+        """Finite zeros of ``G_{output,input}(z)`` (leading zero coefficients dropped).
+
+        Parameters
+        ----------
+        output, input : int
+            Channel pair (default 0, 0).
+
+        Returns
+        -------
+        ndarray of complex
+            Empty when the numerator has at most one coefficient after its leading zeros.
+        """
         num = np.trim_zeros(self.numerators[output, input], "f")
         return np.roots(num) if num.size > 1 else np.array([])
 
@@ -256,7 +277,17 @@ class LinearModel:
         )
 
     def verdict(self, output: int = 0) -> Any:
-        """Identifiability of the fit in plain words (:func:`clpc.model.verdict.fit_verdict`)."""
+        """Identifiability of the fit in plain words (:func:`clpc.model.verdict.fit_verdict`).
+
+        Parameters
+        ----------
+        output : int
+            Output index whose equation is judged (default 0).
+
+        Returns
+        -------
+        Verdict
+        """
         from clpc.model.verdict import fit_verdict
 
         return fit_verdict(self, output)
@@ -268,11 +299,34 @@ class LinearModel:
         return _unc.covariance(self)
 
     def confidence_interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
-        """``(lo, hi)`` ordered like ``np.r_[den[1:], num]`` (rows per output if several)."""
+        """``(lo, hi)`` ordered like ``np.r_[den[1:], num]`` (rows per output if several).
+
+        Parameters
+        ----------
+        level : float
+            Two-sided confidence level in (0, 1) (default 0.95; Student's ``t`` quantile).
+
+        Returns
+        -------
+        lo, hi : ndarray, shape (q,) for a SISO model, else (n_outputs, q)
+            See :func:`clpc.model.uncertainty.confidence_interval`.
+        """
         return _unc.confidence_interval(self, level)
 
     def pole_std(self, output: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """Poles and the std of their real and imaginary parts, shape (na, 2)."""
+        """Poles and the std of their real and imaginary parts, shape (na, 2).
+
+        Parameters
+        ----------
+        output : int
+            Output index (default 0).
+
+        Returns
+        -------
+        poles : ndarray of complex, shape (na,)
+        std : ndarray, shape (na, 2)
+            Standard deviation of ``(Re p, Im p)`` per pole (delta method).
+        """
         return _unc.pole_std(self, output)
 
     def dc_gain_std(self) -> np.ndarray:
@@ -282,7 +336,25 @@ class LinearModel:
     def frequency_response_std(
         self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(freqs_hz, response, std of |G|, std of arg G [rad])`` (delta method)."""
+        """``(freqs_hz, response, std of |G|, std of arg G [rad])`` (delta method).
+
+        Parameters
+        ----------
+        freqs : int or ndarray
+            Number of frequencies up to Nyquist, or frequencies [Hz] (default 512).
+        output, input : int
+            Channel pair (default 0, 0).
+
+        Returns
+        -------
+        freqs_hz : ndarray, shape (n_freqs,)
+            Frequencies [Hz].
+        response : ndarray of complex, shape (n_freqs,)
+        magnitude_std : ndarray, shape (n_freqs,)
+            Standard deviation of ``|G|`` (same units as ``|G|``).
+        phase_std : ndarray, shape (n_freqs,)
+            Standard deviation of ``arg G`` [rad].
+        """
         return _unc.frequency_response_std(self, freqs, output, input)
 
     def summary(self) -> str:
@@ -383,7 +455,19 @@ class LinearModel:
         return np.pad(num, (0, n - num.size)), np.pad(den, (0, n - den.size))
 
     def to_scipy(self, output: int = 0, input: int = 0) -> signal.dlti:
-        """Export one channel pair as :class:`scipy.signal.dlti` (``dt`` = sample time)."""
+        """Export one channel pair as :class:`scipy.signal.dlti` (``dt`` = sample time).
+
+        Parameters
+        ----------
+        output, input : int
+            Channel pair (default 0, 0).
+
+        Returns
+        -------
+        scipy.signal.dlti
+            ``num / den`` in descending powers of ``z``; the constant ``intercept`` is not
+            exported.
+        """
         num, den = self._padded(output, input)
         # leading zeros (input delay nk) are zero high-power coefficients: dropping them keeps
         # G(z) and spares scipy's "badly conditioned numerator" warning

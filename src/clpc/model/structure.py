@@ -52,7 +52,19 @@ class Structure:
 
     @classmethod
     def from_order(cls, order: int, nk: int = 0) -> Structure:
-        """The paper's structure: ``na = nb = order``."""
+        """The paper's structure: ``na = nb = order``.
+
+        Parameters
+        ----------
+        order : int
+            The paper's order ``N`` (>= 1).
+        nk : int
+            Input delay in samples (>= 0, default 0).
+
+        Returns
+        -------
+        Structure
+        """
         order = check_int(order, "order", 1)
         return cls(order, order, nk)
 
@@ -60,7 +72,23 @@ class Structure:
     def from_settings(
         cls, order: int, na: int | None = None, nb: int | None = None, nk: int = 0
     ) -> Structure:
-        """``na = nb = order`` unless ``na``/``nb`` are given (estimator settings)."""
+        """``na = nb = order`` unless ``na``/``nb`` are given (estimator settings).
+
+        Parameters
+        ----------
+        order : int
+            Order used for whichever of ``na``, ``nb`` is not given.
+        na : int, optional
+            Output order (>= 1).
+        nb : int, optional
+            Input order (>= 0).
+        nk : int
+            Input delay in samples (>= 0, default 0).
+
+        Returns
+        -------
+        Structure
+        """
         if na is None and nb is None:
             return cls.from_order(order, nk)
         return cls(order if na is None else na, order if nb is None else nb, nk)
@@ -71,11 +99,33 @@ class Structure:
         return max(self.na, self.nk + self.nb)
 
     def n_params(self, n_inputs: int = 1) -> int:
-        """Length of ``theta = [a; b_1; ...; b_m]`` for ``n_inputs`` inputs."""
+        """Length of ``theta = [a; b_1; ...; b_m]`` for ``n_inputs`` inputs.
+
+        Parameters
+        ----------
+        n_inputs : int
+            Number of input blocks ``m`` in one equation (default 1).
+
+        Returns
+        -------
+        int
+            ``na + 1 + n_inputs (nb + 1)``.
+        """
         return self.na + 1 + n_inputs * (self.nb + 1)
 
     def n_rows(self, n_samples: int) -> int:
-        """Number of lag vectors in a record of ``n_samples`` samples."""
+        """Number of lag vectors in a record of ``n_samples`` samples.
+
+        Parameters
+        ----------
+        n_samples : int
+            Samples in the record (one experiment).
+
+        Returns
+        -------
+        int
+            ``max(n_samples - max_lag, 0)``.
+        """
         return max(n_samples - self.max_lag, 0)
 
 

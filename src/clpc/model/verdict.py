@@ -150,7 +150,20 @@ _NO_EIGENVALUES = {
 
 
 def fit_verdict(model: Any, output: int = 0) -> Verdict:
-    """The verdict of a fit (:meth:`clpc.LPC.fit`, :meth:`clpc.ARX.fit`) for one output."""
+    """The verdict of a fit (:meth:`clpc.LPC.fit`, :meth:`clpc.ARX.fit`) for one output.
+
+    Parameters
+    ----------
+    model : LinearModel
+        A fitted model; its ``info`` holds the solve's statistics and the assessment when
+        the estimator stored them (without them the verdict says so).
+    output : int
+        Output index whose equation is judged (default 0).
+
+    Returns
+    -------
+    Verdict
+    """
     info = model.info
     words, found = evidence(info, output)
     stable, kind, said = _stability(model, output)
@@ -229,6 +242,11 @@ def _ranges(runs: list[tuple[int, int]], limit: int = 6) -> str:
 
 def describe_trace(trace: Any) -> list[str]:
     """Plain-language findings over the clusters of a CLPC trace (clusters numbered from 1).
+
+    Parameters
+    ----------
+    trace : Trace
+        The per-cluster record of a CLPC run (:class:`clpc.Trace`).
 
     Returns
     -------

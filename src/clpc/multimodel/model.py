@@ -151,9 +151,22 @@ class MultiModel:
     def from_trace(cls, trace: Any, u: Any, y: Any, **settings: Any) -> MultiModel:
         """A multi-model whose centres come from a CLPC trace's windows (when they are local).
 
-        The structure is the trace's; the windows are its trusted ones; ``u``, ``y`` are the
-        record the trace was computed on (at the trace's sample time). ``settings`` are the
-        other constructor arguments.
+        The structure is the trace's; the windows are its trusted ones. Further keyword
+        arguments (``settings``) are the other constructor arguments (not the orders).
+
+        Parameters
+        ----------
+        trace : Trace
+            A CLPC trace (:class:`clpc.Trace`) with at least one trusted window.
+        u : array_like, shape (T,) or (T, n_inputs)
+            Inputs of the record the trace was computed on.
+        y : array_like, shape (T,)
+            Its output; the sample time is the trace's.
+
+        Returns
+        -------
+        MultiModel
+            Fitted.
         """
         s = trace.structure
         mm = cls(na=s.na, nb=s.nb, nk=s.nk, **settings)
@@ -199,7 +212,18 @@ class MultiModel:
         return dict(self._require().diagnostics)
 
     def validity(self, psi: Any) -> np.ndarray:
-        """Validities of every local model at ``psi``: shape ``psi.shape + (M,)``, rows sum to 1."""
+        """Validities of every local model at ``psi``: shape ``psi.shape + (M,)``, rows sum to 1.
+
+        Parameters
+        ----------
+        psi : float or array_like
+            Values of the scheduling variable (its units, e.g. those of ``y``).
+
+        Returns
+        -------
+        ndarray, shape ``psi.shape + (M,)``
+            Normalised Gaussian validities.
+        """
         f = self._require()
         return validity(psi, f.centres, f.widths)
 
@@ -248,6 +272,15 @@ class MultiModel:
         The first ``max(max_lag, schedule lag)`` samples are returned as measured; each
         step feeds the previous step's predictions into the output lags and the schedule.
 
+        Parameters
+        ----------
+        u : array_like, shape (T,) or (T, n_inputs)
+            Input samples.
+        y : array_like, shape (T,)
+            Measured output.
+        k : int
+            Prediction horizon in samples (>= 1, default 1).
+
         Returns
         -------
         ndarray, shape (T,)
@@ -270,6 +303,16 @@ class MultiModel:
         Its monic coefficients are the validity-weighted means of the local models' at
         ``psi = operating_point`` (the scheduling variable held there; the derivative of
         the validities is left out).
+
+        Parameters
+        ----------
+        operating_point : float
+            Value of the scheduling variable (its units) to freeze the validities at.
+
+        Returns
+        -------
+        LinearModel
+            Single output, ``dt`` the multi-model's; ``info["operating_point"]`` records it.
         """
         f = self._require()
         den, num, icpt = monic_arrays(f.local_models)
@@ -297,20 +340,46 @@ class MultiModel:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> MultiModel:
-        """Rebuild a multi-model from :meth:`to_dict` output."""
+        """Rebuild a multi-model from :meth:`to_dict` output.
+
+        Parameters
+        ----------
+        data : dict
+            The description; its ``format`` and ``version`` are checked.
+
+        Returns
+        -------
+        MultiModel
+        """
         from clpc.multimodel.store import from_dict
 
         return from_dict(cls, data)
 
     def save(self, path: Any) -> None:
-        """Write :meth:`to_dict` as JSON to ``path``."""
+        """Write :meth:`to_dict` as JSON to ``path``.
+
+        Parameters
+        ----------
+        path : str or path-like
+            File to write (UTF-8; replaced if it exists).
+        """
         from clpc.multimodel.store import save
 
         save(self, path)
 
     @classmethod
     def load(cls, path: Any) -> MultiModel:
-        """Read a multi-model written by :meth:`save`."""
+        """Read a multi-model written by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or path-like
+            JSON file written by :meth:`save`.
+
+        Returns
+        -------
+        MultiModel
+        """
         from clpc.multimodel.store import load
 
         return load(cls, path)

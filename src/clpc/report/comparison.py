@@ -50,7 +50,19 @@ class Comparison:
         return self.data.y[self.start :] - self.y_hat[self.start :]
 
     def plot(self, path: str | PathLike[str] | None = None, *, ax: Any = None) -> Any:
-        """Measured, model output and residuals (:func:`clpc.plotting.plot_fit`)."""
+        """Measured, model output and residuals (:func:`clpc.plotting.plot_fit`).
+
+        Parameters
+        ----------
+        path : str or path-like, optional
+            Also write the figure as PNG here.
+        ax : sequence of matplotlib Axes, optional
+            ``2 * n_outputs`` axes (output, residual per output); default: a new figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from clpc.plotting import plot_fit
 
         return plot_fit(self.model, self.data, path, k=self.k, ax=ax)

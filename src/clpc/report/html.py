@@ -124,7 +124,20 @@ def _image_html(image: Image, report_dir: Path, embed: bool) -> str:
 
 
 def warnings_html(warnings: Sequence[str], title: str = "Warnings") -> str:
-    """The highlighted box of a :class:`Section`'s ``warnings`` (text escaped), as HTML."""
+    """The highlighted box of a :class:`Section`'s ``warnings`` (text escaped), as HTML.
+
+    Parameters
+    ----------
+    warnings : sequence of str
+        The warnings, one list item each (plain text).
+    title : str
+        Heading of the box (plain text, default ``"Warnings"``).
+
+    Returns
+    -------
+    str
+        A ``<div class="warn">`` element.
+    """
     items = "".join(f"<li>{html.escape(w)}</li>" for w in warnings)
     return (
         f'<div class="warn" role="note"><strong>{html.escape(title)}</strong><ul>{items}</ul></div>'

@@ -42,6 +42,17 @@ def verdict_text(model: LinearModel, output: int = 0) -> str | None:
     (``determined``, ``n_null``, ``n_input_relations``...) and the evidence a fit stored
     (``heldout``, ``residual_test``); ``None`` for models with neither (e.g. a CLPC
     steady-state model or a hand-built one).
+
+    Parameters
+    ----------
+    model : LinearModel
+        A fitted model.
+    output : int
+        Output index whose equation is judged (default 0).
+
+    Returns
+    -------
+    str or None
     """
     has_eig = all(k in model.info for k in ("n_null", "n_input_relations", "determined"))
     if not has_eig and "heldout" not in model.info:
@@ -208,6 +219,16 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
     ``noise_variance``, ``J``, ``c``, ``n_null``, ``n_input_relations``, ``degenerate``,
     ``determined``, ``accepted``, ``has_model``, ``stable``. For single-output traces the
     per-equation values are scalars (``theta`` a list); otherwise one entry per output.
+
+    Parameters
+    ----------
+    trace : Trace
+        A CLPC trace (:class:`clpc.Trace`).
+
+    Returns
+    -------
+    list of dict
+        One per update, in order.
     """
     a = trace.arrays
     single = trace.n_equations == 1
@@ -231,6 +252,12 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
 def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
     """The model a trace settles on, and where it comes from.
 
+    Parameters
+    ----------
+    trace : Trace
+        A CLPC trace (:class:`clpc.Trace`); convergence is judged with the default
+        tolerances of :meth:`Trace.convergence`.
+
     Returns
     -------
     model : LinearModel or None
@@ -251,6 +278,12 @@ def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
 
 def trace_summary(trace: Trace) -> dict[str, Any]:
     """Counts, convergence and plain-language findings of a CLPC trace, JSON-safe.
+
+    Parameters
+    ----------
+    trace : Trace
+        A CLPC trace (:class:`clpc.Trace`); convergence is judged with the default
+        tolerances of :meth:`Trace.convergence`.
 
     Returns
     -------

@@ -27,7 +27,17 @@ def _fit_label(key: str) -> str:
 
 
 def format_fit(v: float | None) -> str:
-    """A fit % for people: ``"87.29 %"``, ``"-1.2e+34 %"`` or ``"n/a (diverges)"``."""
+    """A fit % for people: ``"87.29 %"``, ``"-1.2e+34 %"`` or ``"n/a (diverges)"``.
+
+    Parameters
+    ----------
+    v : float or None
+        Fit [%]; ``None`` or non-finite when the model diverges.
+
+    Returns
+    -------
+    str
+    """
     if v is None or not math.isfinite(v):
         return "n/a (diverges)"
     return f"{v:.2f} %" if abs(v) < 1e5 else f"{v:.3g} %"
@@ -47,7 +57,18 @@ def estimator_name(summary: Mapping[str, Any]) -> str:
 
 
 def format_model_summary(summary: Mapping[str, Any]) -> str:
-    """Render :func:`model_summary` as readable text (one block per output)."""
+    """Render :func:`model_summary` as readable text (one block per output).
+
+    Parameters
+    ----------
+    summary : mapping
+        Output of :func:`clpc.report.model_summary` (with or without data).
+
+    Returns
+    -------
+    str
+        Several lines, no trailing newline.
+    """
     st = summary["structure"]
     lines = [
         f"{estimator_name(summary)} model  na={st['na']} nb={st['nb']} nk={st['nk']}  "
