@@ -4,8 +4,9 @@ Each row is one path at one record length T, run in this process after one warm-
 short record: ``LPC(order=2).fit``, ``ARX(order=2).fit``, ``OE(order=2).fit``, the evidence
 a fit offers on demand (``model.assess()``: held-out refit, residual tests, jackknife),
 ``predict(k)`` at a short and a long horizon, and ``identify`` with order, delay and
-estimator automatic (``--identify``, the slow one). The reference is ``numpy.linalg.lstsq``
-on the same SISO lag matrix (``y(n)`` on the five other lag entries), timed in the same run.
+estimator automatic (``--identify``, the slow one). The references, timed in the same run on
+the same SISO lag matrix: ``numpy.linalg.lstsq`` of ``y(n)`` on the five other lag entries
+("x lstsq"), and the bare LPC solve, ``numpy.linalg.svd`` of the centered lag matrix ("x svd").
 Peak memory is the largest allocation traced by ``tracemalloc`` (numpy reports its arrays to
 it) during the call, in MB; the lag matrix itself is 8 * 6 * T bytes (48 MB at 1e6).
 
@@ -58,6 +59,13 @@ def lstsq_reference(data: clpc.IOData) -> Callable[[], Any]:
     return lambda: np.linalg.lstsq(rows[:, 1:], rows[:, 0], rcond=None)
 
 
+def svd_reference(data: clpc.IOData) -> Callable[[], Any]:
+    """The bare LPC solve: the SVD of the centered order-2 lag matrix."""
+    u, y = data.u[:, 0], data.y[:, 0]
+    rows = np.column_stack([y[2:], y[1:-1], y[:-2], u[2:], u[1:-1], u[:-2]])
+    return lambda: np.linalg.svd(rows - rows.mean(axis=0), full_matrices=False)
+
+
 def paths(data: clpc.IOData, with_identify: bool) -> dict[str, Callable[[], Any]]:
     """The batch paths measured on ``data``."""
     u, y = data.u[:, 0], data.y[:, 0]
@@ -86,15 +94,19 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     clpc.LPC(order=2).fit(record(2000)).assess()  # warm-up: imports, first calls
-    print(f"{'path':<18} {'T':>9} {'time [s]':>10} {'peak [MB]':>10} {'x lstsq':>8}")
+    head = f"{'path':<18} {'T':>9} {'time [s]':>10} {'peak [MB]':>10} {'x lstsq':>8} {'x svd':>8}"
+    print(head)
     for n in args.sizes:
         data = record(n)
         ref, _ = measure(lstsq_reference(data), args.repeat)
-        print(f"{'numpy lstsq':<18} {n:>9} {ref:>10.4f} {'':>10} {1.0:>8.2f}")
+        svd, _ = measure(svd_reference(data), args.repeat)
+        print(f"{'numpy lstsq':<18} {n:>9} {ref:>10.4f} {'':>10} {1.0:>8.2f} {ref / svd:>8.2f}")
+        print(f"{'numpy svd':<18} {n:>9} {svd:>10.4f} {'':>10} {svd / ref:>8.2f} {1.0:>8.2f}")
         for name, fn in paths(data, args.identify).items():
             repeat = 1 if name in ("identify auto", "OE fit") else args.repeat
             seconds, peak = measure(fn, repeat)
-            print(f"{name:<18} {n:>9} {seconds:>10.4f} {peak:>10.1f} {seconds / ref:>8.2f}")
+            ratios = f"{seconds / ref:>8.2f} {seconds / svd:>8.2f}"
+            print(f"{name:<18} {n:>9} {seconds:>10.4f} {peak:>10.1f} {ratios}")
 
 
 if __name__ == "__main__":

@@ -27,7 +27,7 @@ from clpc.model import LinearModel, ModelError
 from clpc.model.evidence import FitRecord
 from clpc.model.residuals import residual_analysis
 
-__all__ = ["HELDOUT_FRACTION", "assess", "evidence", "with_record"]
+__all__ = ["HELDOUT_FRACTION", "assess", "evidence", "fit_record"]
 
 #: Share of the record held out (the last part), as :func:`clpc.select_order` does.
 HELDOUT_FRACTION = 1.0 / 3.0
@@ -102,20 +102,17 @@ def evidence(
     }
 
 
-def with_record(
-    model: LinearModel,
+def fit_record(
     data: IOData,
     estimator: Any,
     covariance: Callable[[LinearModel], dict[str, Any]] | None = None,
-) -> LinearModel:
-    """The tail of every fit: ``model`` keeping its record and its evidence on demand.
+) -> FitRecord:
+    """The record a fit keeps, with the evidence it offers on demand.
 
     Parameters
     ----------
-    model : LinearModel
-        The estimate.
     data : IOData
-        The record it was fitted on.
+        The record the model is fitted on.
     estimator : LPC, ARX or OE
         The estimator (a dataclass with ``assess`` and ``uncertainty`` flags): with
         ``assess``, :func:`evidence` is offered, refitting a copy of it without evidence.
@@ -124,8 +121,8 @@ def with_record(
 
     Returns
     -------
-    LinearModel
-        With a :class:`clpc.model.evidence.FitRecord`; nothing is computed yet.
+    FitRecord
+        Nothing is computed yet (:mod:`clpc.model.evidence`).
     """
     record = FitRecord(data)
     if covariance is not None:
@@ -133,7 +130,7 @@ def with_record(
     if estimator.assess:
         refit = replace(estimator, assess=False, uncertainty=False).fit
         record = record.with_producer("assessment", lambda fitted: evidence(fitted, data, refit))
-    return replace(model, record=record)
+    return record
 
 
 def assess(model: LinearModel, data: IOData, refit: Callable[[IOData], LinearModel]) -> LinearModel:

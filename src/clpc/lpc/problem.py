@@ -5,7 +5,7 @@ LPC, least squares and output error differ in the solver only. Each ``fit`` star
 against the channels, enough samples for the parameters) and ends with
 :meth:`FitProblem.model` (the :class:`~clpc.model.LinearModel` with the record's names, its
 covariance or why there is none, and the evidence offered on demand:
-:func:`clpc.lpc.assessment.with_record`).
+:func:`clpc.lpc.assessment.fit_record`).
 """
 
 from __future__ import annotations
@@ -147,7 +147,7 @@ class FitProblem:
             info = {**info, **covariance_entries(covariance.cov, covariance.dof, covariance.method)}
         elif covariance is not None:
             info = {**info, "covariance_note": covariance.note}
-        model = LinearModel(
+        return LinearModel(
             theta=theta,
             structure=self.structure,
             n_inputs=data.n_inputs,
@@ -157,5 +157,5 @@ class FitProblem:
             input_names=data.input_names,
             output_names=data.output_names,
             info=info,
+            record=assessment.fit_record(data, estimator, produce),
         )
-        return assessment.with_record(model, data, estimator, produce)

@@ -59,7 +59,8 @@ def reduce_model(model: LinearModel, data: IOData, tol: float = CANCEL_DISTANCE)
     removed = {m for _, _, m in parts}
     m = removed.pop() if len(removed) == 1 else 0
     if m == 0 or s.na - m < 1 or s.nb - m < 0:
-        return replace(model, info=info)
+        model.info.update(fitted_structure=info["fitted_structure"], cancelled=0)
+        return model  # nothing to cancel: the same model, its info told so
     reduced = Structure(s.na - m, s.nb - m, s.nk)
     theta = np.array(
         [_theta(den, num, model.mode, j, s.nk) for j, (den, num, _) in enumerate(parts)]

@@ -20,6 +20,7 @@ models keep only input ``j``; the others are zero).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -146,6 +147,12 @@ class LinearModel:
         return a0
 
     def _monic(self) -> tuple[np.ndarray, np.ndarray]:
+        """Both monic polynomials of every output (copies of :meth:`_monic_once`'s)."""
+        den, num = self._monic_once
+        return den.copy(), num.copy()
+
+    @functools.cached_property
+    def _monic_once(self) -> tuple[np.ndarray, np.ndarray]:
         """Both monic polynomials of every output (:func:`clpc.core.polynomials.monic`)."""
         self._a0()  # a0 must be nonzero
         s = self.structure
