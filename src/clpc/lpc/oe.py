@@ -33,13 +33,11 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core.polynomials import cancel_common_factors
 from clpc.data import DataError, IOData
+from clpc.lpc import oe_search
 from clpc.lpc.arx import ARX
 from clpc.lpc.estimator import LPC
 from clpc.lpc.problem import Covariance, FitProblem
-from clpc.lpc.reduction import KEEP_FIT_POINTS
-from clpc.lpc.reflection import MAX_KAPPA, reflection_from_poly
 from clpc.lpc.regressors import MimoMode, Structure, lagged
 from clpc.lpc.simulation_error import SEGMENTS, SimulationError
 from clpc.lpc.uncertainty import monic_map
@@ -182,8 +180,8 @@ class OE:
             )
             fits = {}
             for name, model in starts.items():
-                x0 = _start_vector(model, j, list(cols), structure)
-                res = _search(prob, x0, self.max_nfev)
+                x0 = oe_search.start_vector(model, j, list(cols), structure)
+                res = oe_search.search(prob, x0, self.max_nfev)
                 if np.isfinite(res.cost):
                     fits[name] = res
             if not fits:
@@ -195,10 +193,12 @@ class OE:
             a, _, b, k = prob.split(fits[best].x)
             solved, x_opt, cancelled = prob, fits[best].x, 0
             if self.cancel:
-                kept = _cancelled(prob, x_opt, data, list(cols), structure, self.max_nfev)
+                kept = oe_search.without_near_pairs(
+                    prob, x_opt, data, list(cols), structure, self.max_nfev
+                )
                 if kept is not None:
                     solved, x_opt, cancelled = kept
-                    a, b, k = _padded(solved, x_opt, cancelled, len(cols))
+                    a, b, k = oe_search.padded(solved, x_opt, cancelled, len(cols))
             if self.uncertainty and not no_cov:
                 try:
                     low = Structure(
@@ -206,7 +206,7 @@ class OE:
                     )
                     lmap = monic_map(low, data.n_inputs, mode, j)
                     cov_j, dof_j = solved.covariance(x_opt, lmap)
-                    emb = _embedding(low, structure, data.n_inputs)
+                    emb = oe_search.embedding(low, structure, data.n_inputs)
                     covs.append((emb @ cov_j @ emb.T, dof_j))
                 except ValueError as exc:
                     no_cov = f"output {data.output_names[j]}: {exc}"
@@ -270,107 +270,3 @@ class OE:
                 )
             starts["initial"] = init
         return starts
-
-
-def _search(prob: SimulationError, x0: np.ndarray, max_nfev: int) -> Any:
-    """Levenberg-Marquardt on ``prob`` from ``x0`` (``scipy.optimize.least_squares``)."""
-    from scipy import optimize  # imported when used (as scipy.signal: ~0.8 s)
-
-    return optimize.least_squares(
-        prob.residual,
-        x0,
-        jac=prob.jacobian,
-        method="lm",
-        x_scale="jac",
-        xtol=1e-14,
-        ftol=1e-14,
-        gtol=1e-14,
-        max_nfev=max_nfev,
-    )
-
-
-def _objective_fit(prob: SimulationError, x: np.ndarray) -> float:
-    """Fit % of the objective: every run's errors against the spread of their targets."""
-    t = prob.targets()
-    return float(100.0 * (1.0 - np.linalg.norm(prob.residual(x)) / np.linalg.norm(t - t.mean())))
-
-
-def _rho(den: np.ndarray) -> np.ndarray:
-    """The search's ``rho`` of a stable monic ``den`` (its reflection coefficients, clipped)."""
-    kappa = np.clip(reflection_from_poly(den), -MAX_KAPPA * (1 - 1e-12), MAX_KAPPA * (1 - 1e-12))
-    return np.arctanh(kappa / MAX_KAPPA)
-
-
-def _start_vector(model: LinearModel, j: int, cols: list[int], structure: Structure) -> np.ndarray:
-    """``[rho; b; k]`` of output ``j`` of a start model (made stable first)."""
-    den = model.denominators[j]
-    b = np.concatenate([model.numerators[j, i, structure.nk :] for i in cols])
-    x0 = np.concatenate([_rho(den), b, [model.intercept[j]]])
-    if not np.all(np.isfinite(x0)):
-        raise ModelError(f"the start model of output {j} has non-finite parameters.")
-    return x0
-
-
-def _cancelled(
-    prob: SimulationError,
-    x: np.ndarray,
-    data: IOData,
-    cols: list[int],
-    structure: Structure,
-    max_nfev: int,
-) -> tuple[SimulationError, np.ndarray, int] | None:
-    """The fit without its near pole/zero pairs, refitted at the lower order (or ``None``).
-
-    Pairs common to every input's numerator and closer than
-    :data:`~clpc.core.polynomials.CANCEL_DISTANCE` are removed and the search is run again
-    at ``(na - m, nb - m)`` from what is left, on the same runs. The lower order is kept
-    when its objective fit % (:func:`_objective_fit`) is within
-    :data:`~clpc.lpc.reduction.KEEP_FIT_POINTS` of the fitted order's, or better (the rule
-    of LPC's reduction). Returns the lower-order problem, its optimum and ``m``.
-    """
-    a, _, b, _ = prob.split(x)
-    nb, nk = structure.nb, structure.nk
-    nums = np.array([np.r_[np.zeros(nk), part] for part in np.split(b, len(cols))])
-    den, red, m = cancel_common_factors(a, nums)
-    if m == 0 or structure.na - m < 1 or nb - m < 0:
-        return None
-    small = SimulationError(
-        prob.y,
-        np.hstack([lagged(data.u[:, i], nb - m, nk, structure.max_lag) for i in cols]),
-        structure.na - m,
-        structure.max_lag,
-        prob.segments,
-        prob.full_run,
-    )
-    x0 = np.concatenate([_rho(den), red[:, nk:].ravel(), [0.0]])
-    res = _search(small, x0, max_nfev)
-    if not np.isfinite(res.cost):
-        return None
-    if _objective_fit(small, res.x) < _objective_fit(prob, x) - KEEP_FIT_POINTS:
-        return None  # the pair is real dynamics: keep the fitted order
-    return small, res.x, m
-
-
-def _padded(
-    small: SimulationError, xs: np.ndarray, m: int, n_cols: int
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """``a``, ``b``, ``k`` of the lower-order optimum with ``m`` zeros after ``A`` and each ``B``.
-
-    A pole and a zero at ``z = 0`` cancel exactly: the padded model is the lower-order one,
-    written in the fitted structure.
-    """
-    a, _, b, k = small.split(xs)
-    b_full = np.concatenate([np.r_[part, np.zeros(m)] for part in np.split(b, n_cols)])
-    return np.r_[a, np.zeros(m)], b_full, k
-
-
-def _embedding(low: Structure, full: Structure, n_inputs: int) -> np.ndarray:
-    """0/1 matrix carrying the monic vector of ``low`` into the positions of ``full``'s."""
-    width_lo, width = low.nk + low.nb + 1, full.nk + full.nb + 1
-    rows = np.r_[
-        np.arange(low.na),
-        [full.na + i * width + t for i in range(n_inputs) for t in range(width_lo)],
-    ]
-    out = np.zeros((full.na + n_inputs * width, low.na + n_inputs * width_lo))
-    out[rows.astype(int), np.arange(out.shape[1])] = 1.0
-    return out
