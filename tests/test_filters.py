@@ -9,12 +9,16 @@ from scipy import signal
 from clpc.core import filters
 from clpc.core.filters import all_pole, fir, frequency_response
 
-RNG = np.random.default_rng(11)
+
+@pytest.fixture
+def rng():
+    """The same samples for every test, whatever ran before it (tests run in any order)."""
+    return np.random.default_rng(11)
 
 
 @pytest.mark.parametrize("b", [[0.2], [0.2, 0.5, -0.1], [0.0, 0.0, 1.5, 0.3]])
-def test_fir_is_lfilter_from_rest(b):
-    x = RNG.standard_normal(5000)
+def test_fir_is_lfilter_from_rest(b, rng):
+    x = rng.standard_normal(5000)
     np.testing.assert_allclose(fir(np.array(b), x), signal.lfilter(b, [1.0], x), rtol=0, atol=1e-13)
 
 
@@ -26,9 +30,9 @@ def test_fir_of_empty_signal_or_coefficients_is_zeros():
 @pytest.mark.parametrize(
     "den", [[1.0, -1.5, 0.7], [1.0, -0.95], [1.0, -2.2, 1.85, -0.6], [2.0, -1.0, 0.3]]
 )
-def test_all_pole_is_lfilter_started_from_past_outputs(den):
-    x = RNG.standard_normal(4000)
-    past = RNG.standard_normal(len(den) - 1)
+def test_all_pole_is_lfilter_started_from_past_outputs(den, rng):
+    x = rng.standard_normal(4000)
+    past = rng.standard_normal(len(den) - 1)
     zi = signal.lfiltic([1.0], den, past)
     ref = signal.lfilter([1.0], den, x, zi=zi)[0]
     got = all_pole(np.array(den), x, past)
@@ -41,17 +45,17 @@ def test_all_pole_is_lfilter_started_from_past_outputs(den):
 
 
 @pytest.mark.parametrize("block", [1, 2, 7, 4000])
-def test_all_pole_carries_the_outputs_across_blocks(block, monkeypatch):
+def test_all_pole_carries_the_outputs_across_blocks(block, monkeypatch, rng):
     den = np.array([1.0, -2.2, 1.85, -0.6])
-    x = RNG.standard_normal(1000)
-    past = RNG.standard_normal(3)
+    x = rng.standard_normal(1000)
+    past = rng.standard_normal(3)
     whole = all_pole(den, x, past)
     monkeypatch.setattr(filters, "BLOCK", block)
     np.testing.assert_allclose(all_pole(den, x, past), whole, rtol=1e-13, atol=1e-13)
 
 
-def test_all_pole_without_poles_returns_the_input():
-    x = RNG.standard_normal(10)
+def test_all_pole_without_poles_returns_the_input(rng):
+    x = rng.standard_normal(10)
     np.testing.assert_array_equal(all_pole(np.array([1.0]), x), x)
 
 
