@@ -8,6 +8,7 @@ loaded, this extension rewrites every docstring:
 * a role becomes an optional cross-reference (autorefs): a link when the target is rendered on
   some page of the site, plain code otherwise (never a warning, so ``mkdocs build --strict``
   fails only on real broken links);
+* a parameter's choices ``{"a", "b"}`` become ``"a" | "b"`` (griffe would print a tuple);
 * a run of ``>>>`` lines (with their output) outside a fenced block becomes a ``pycon`` block
   (without its ``# doctest:`` flags).
 
@@ -23,6 +24,9 @@ from typing import Any
 import griffe
 
 DOCTEST_FLAG = re.compile(r"\s*# doctest:.*$")
+CHOICES = re.compile(
+    r"^(?P<head>\s*\*{0,2}\w+(?:, \*{0,2}\w+)* : )\{(?P<choices>[^{}]+)\}\s*$", re.MULTILINE
+)
 ROLE = re.compile(r":(?:py:)?(class|func|meth|mod|data|attr|exc|obj|const):`(?P<body>[^`]+)`")
 
 
@@ -103,6 +107,8 @@ class SphinxRoles(griffe.Extension):
                 f"<code>{html.escape(shown)}</code></autoref>"
             )
 
+        # numpydoc's {"a", "b"} would print as a tuple ('a', 'b'); "a" | "b" reads as the choice
+        text = CHOICES.sub(lambda m: m["head"] + " | ".join(m["choices"].split(", ")), text)
         if ">>>" in text and "Examples\n" not in text:
             text = _pycon(text)
         return ROLE.sub(role, text)
