@@ -454,3 +454,44 @@ def test_table_basics():
     assert "Table(n_rows=2" in repr(table)
     with pytest.raises(DataError, match="one name per column"):
         Table(["a"], [[1, 2]])
+
+
+# ------------------------------------------------- the pyarrow reader's line numbers
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("u y\n1 2\n\n# c\n3\n", r"line 5 has 1 field\(s\) but the header \(line 1\)"),
+        ("u,y\n# c,d\n1,2\n\n3,4,5\n", r"line 5 has 3 field\(s\)"),
+        ("u y\n1 2\n  # note\n\n3 x\n", r"line 5, column 'y': 'x' is not a number"),
+        ("u\n1\n\n   \n# c\nabc\n", r"line 6, column 'u': 'abc' is not a number"),
+    ],
+)
+def test_blank_and_comment_lines_keep_error_lines(tmp_path, text, match):
+    path = write(tmp_path / "w.txt", text)
+    with pytest.raises(DataError, match=match):
+        read_table(path)
+    with pytest.raises(DataError, match=match):
+        chunks_concat(path, 1)
+
+
+def test_one_column_and_whitespace_files_skip_blank_and_comment_lines(tmp_path):
+    path = write(tmp_path / "one.csv", "u\n1\n\n   \n# c\n2 # two\n")
+    table = read_table(path)
+    assert table.data[:, 0].tolist() == [1, 2]
+    assert [table.row_label(i) for i in range(2)] == ["line 2", "line 6"]
+    path = write(tmp_path / "ws.dat", "t u\n# c\n 0\t1.5 \n\n1   2.5\n")
+    assert read_table(path).data.tolist() == [[0, 1.5], [1, 2.5]]
+
+
+def test_bad_cell_in_a_later_block_names_its_line(tmp_path):
+    n = 400_000  # more than one pyarrow block
+    lines = [f"{k},{k}.5" for k in range(n)]
+    lines[n - 10] = "1,bad"
+    lines.insert(100, "# a comment")
+    path = write(tmp_path / "big.csv", "u,y\n" + "\n".join(lines) + "\n")
+    with pytest.raises(DataError, match=rf"line {n - 10 + 3}, column 'y': 'bad'"):
+        read_table(path)
+    lines[n - 9] = f"{n - 10},{n - 10}.5"
+    path = write(tmp_path / "big.csv", "u,y\n" + "\n".join(lines) + "\n")
+    table = read_table(path, allow_missing=True)
+    assert table.n_rows == n and table.row_label(n - 1) == f"line {n + 2}"

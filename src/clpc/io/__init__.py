@@ -6,8 +6,8 @@ Where each job lives (one module each):
 - ``errors``: :class:`DataFileNotFoundError` and the one-line bad-cell messages;
 - ``formats``: which format a file is (by its extension), and that it exists;
 - ``text_format``: delimiter and header detection of text files;
-- ``text_reader``: parsing text files batch by batch; ``text_writer``: writing them;
-- ``arrow_text``: the pyarrow fast path of ``text_reader`` (when pyarrow is installed);
+- ``text_reader``: text files read by ``pyarrow.csv`` block by block, each row's file line
+  kept for the messages; ``text_writer``: writing them;
 - ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
 - ``loading``: :func:`read_table`, :func:`iter_table_chunks` (dispatch by extension);
 - ``records``: :func:`load_iodata`; ``writing``: :func:`write_table`;

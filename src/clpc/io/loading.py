@@ -47,7 +47,6 @@ def _open_source(
     header: bool | None,
     allow_missing: bool,
     skip_rows: int = 0,
-    fast: bool = True,
     whole: bool = False,
 ) -> _Source:
     """Check the file, resolve the columns and pick the reader of the file's format.
@@ -61,7 +60,7 @@ def _open_source(
     if skip and kind != "text":
         raise DataError(f"skip_rows applies to text files only; {show(p)} is a {kind} file.")
     if kind == "text":
-        names, chunks = text_source(p, columns, delimiter, header, allow_missing, skip, fast)
+        names, chunks = text_source(p, columns, delimiter, header, allow_missing, skip, whole)
     elif kind == "parquet":
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
@@ -96,7 +95,6 @@ def read_table(
     header: bool | None = None,
     allow_missing: bool = False,
     skip_rows: int = 0,
-    fast: bool = True,
 ) -> Table:
     """Read a whole data file into a :class:`Table`.
 
@@ -120,10 +118,6 @@ def read_table(
     skip_rows : int
         Text files only: physical lines to pass over at the top (e.g. a metadata line).
         A units row right under the header (``s,m,m,V``) is skipped without asking.
-    fast : bool
-        Text files only: parse through pyarrow when it is installed (default), with the
-        plain reader taking over - and naming the line, column and text - wherever pyarrow
-        cannot vouch for a value (:mod:`clpc.io.arrow_text`). ``False``: the plain reader.
 
     Returns
     -------
@@ -141,7 +135,7 @@ def read_table(
     ImportError
         Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
-    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast, whole=True)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
     for values, where in src.chunks(_READ_CHUNK):
@@ -170,7 +164,6 @@ def iter_table_chunks(
     header: bool | None = None,
     allow_missing: bool = False,
     skip_rows: int = 0,
-    fast: bool = True,
 ) -> Iterator[tuple[list[str], np.ndarray]]:
     """Read a data file piece by piece, without holding it all in memory.
 
@@ -188,7 +181,7 @@ def iter_table_chunks(
         Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
         memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
         array in Fortran order and the pandas fallback for Parquet are loaded whole.
-    columns, delimiter, header, allow_missing, skip_rows, fast
+    columns, delimiter, header, allow_missing, skip_rows
         As for :func:`read_table`.
 
     Yields
@@ -204,7 +197,7 @@ def iter_table_chunks(
         As :func:`read_table`; errors in later rows surface when that chunk is reached.
     """
     chunk_rows = _check_chunk_rows(chunk_rows)
-    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows)
 
     def generate() -> Iterator[tuple[list[str], np.ndarray]]:
         empty = True
