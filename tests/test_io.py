@@ -20,7 +20,6 @@ from clpc.io import (
     read_table,
     write_table,
 )
-from clpc.io import parquet as io_parquet
 
 VALUES = np.array([[0.0, 1.5, -2.0], [0.1, 2.5, 3.25], [0.2, -1e-3, 4e5]])
 
@@ -235,7 +234,7 @@ def test_npz_layouts(tmp_path):
         read_table(tmp_path / "bad.npz")
 
 
-def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
+def test_parquet_types_nulls_and_chunks(tmp_path):
     pa = pytest.importorskip("pyarrow")
     pq = pytest.importorskip("pyarrow.parquet")
     stamps = np.datetime64("2024-01-01T00:00:00", "ns") + np.arange(4) * np.timedelta64(10, "ms")
@@ -259,21 +258,9 @@ def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
         read_table(path, columns=["gap"])
     data = load_iodata(path, "u", "flag", time_column="t")
     assert data.dt == 0.01
-    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)  # pandas path
-    np.testing.assert_array_equal(read_table(path, columns=["u", "flag"]).data, got.data[:, 1:])
-    with pytest.raises(DataError, match=r"row 2, column 'gap'"):
-        read_table(path, columns=["gap"])
-
-
-def test_parquet_without_pyarrow_or_pandas(tmp_path, monkeypatch):
-    path = tmp_path / "x.parquet"
-    path.write_bytes(b"PAR1")
-    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)
-    monkeypatch.setattr(io_parquet, "_import_pandas", lambda: None)
-    with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):
-        read_table(path)
-    with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):
-        write_table(tmp_path / "y.parquet", ["u"], [1.0])
+    chunks = [v for _, v in iter_table_chunks(path, 3, columns=["u", "flag"])]
+    assert [c.shape[0] for c in chunks] == [3, 1]
+    np.testing.assert_array_equal(np.concatenate(chunks), got.data[:, 1:])
 
 
 # ------------------------------------------------------------------------ errors

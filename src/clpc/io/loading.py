@@ -132,8 +132,6 @@ def read_table(
     DataError
         Unsupported extension, empty file, unknown column, ragged row, non-numeric or
         missing cell (the message names the line/row, the column and the text).
-    ImportError
-        Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
     src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, whole=True)
     parts: list[np.ndarray] = []

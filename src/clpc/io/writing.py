@@ -48,8 +48,6 @@ def write_table(
     ------
     DataError
         Unsupported extension, or names that do not match the columns.
-    ImportError
-        Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
     p = Path(os.fspath(path))
     kind = file_kind(p)
