@@ -482,3 +482,64 @@ def test_bad_cell_in_a_later_block_names_its_line(tmp_path):
     path = write(tmp_path / "big.csv", "u,y\n" + "\n".join(lines) + "\n")
     table = read_table(path, allow_missing=True)
     assert table.n_rows == n and table.row_label(n - 1) == f"line {n + 2}"
+
+
+# ------------------------------------------------------------------ MATLAB files
+def test_mat_variables_are_columns(tmp_path):
+    from scipy.io import savemat
+
+    t = np.arange(6) * 0.1
+    u = np.sin(t)
+    y = np.arange(6, dtype=np.int16)
+    path = tmp_path / "rec.mat"
+    savemat(path, {"t": t, "u": u[:, None], "y": y, "dt": 0.1, "note": "bench run 3"})
+    table = read_table(path)
+    assert table.names == ["t", "u", "y"]  # scalar dt and text note left out
+    np.testing.assert_array_equal(table.data, np.column_stack([t, u, y]))
+    assert table.row_label(0) == "row 1"
+    data = load_iodata(path, "u", "y", time_column="t")
+    assert data.dt == pytest.approx(0.1)
+    np.testing.assert_array_equal(chunks_concat(path, 4, columns=["y", "t"]), table.data[:, [2, 0]])
+
+
+def test_mat_matrix_names_and_errors(tmp_path):
+    from scipy.io import savemat
+
+    arr = np.arange(12.0).reshape(4, 3)
+    savemat(tmp_path / "m.mat", {"data": arr, "columns": np.array(["a", "b", "c"], dtype=object)})
+    table = read_table(tmp_path / "m.mat", columns=["c", "a"])
+    assert table.names == ["c", "a"]
+    np.testing.assert_array_equal(table.data, arr[:, [2, 0]])
+    savemat(tmp_path / "plain.mat", {"X": arr})
+    assert read_table(tmp_path / "plain.mat").names == ["col0", "col1", "col2"]
+    bad = arr.copy()
+    bad[2, 1] = np.nan
+    savemat(tmp_path / "nan.mat", {"u": bad[:, 0], "y": bad[:, 1]})
+    with pytest.raises(DataError, match=r"row 3, column 'y': 'nan' is not a finite"):
+        read_table(tmp_path / "nan.mat")
+    savemat(tmp_path / "len.mat", {"u": np.ones(3), "y": np.ones(4)})
+    with pytest.raises(DataError, match="differ in length: 'y' has 4 rows but 'u' has 3"):
+        read_table(tmp_path / "len.mat")
+    savemat(tmp_path / "mix.mat", {"u": np.ones(3), "X": np.ones((3, 2))})
+    with pytest.raises(DataError, match="either one 2-D matrix or numeric vectors"):
+        read_table(tmp_path / "mix.mat")
+    savemat(tmp_path / "cplx.mat", {"u": np.ones(3) + 1j})
+    with pytest.raises(DataError, match="complex"):
+        read_table(tmp_path / "cplx.mat")
+    write(tmp_path / "junk.mat", "not a mat file at all")
+    with pytest.raises(DataError, match=r"not a valid \.mat file"):
+        read_table(tmp_path / "junk.mat")
+    hdf = tmp_path / "v73.mat"
+    hdf.write_bytes(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116) + bytes(8) + b"\x00\x02IM")
+    with pytest.raises(DataError, match=r"v7\.3"):
+        read_table(hdf)
+
+
+def test_mat_round_trip_and_names(tmp_path):
+    arr = np.random.default_rng(4).standard_normal((50, 2))
+    write_table(tmp_path / "r.mat", ["u", "y_pos"], arr)
+    table = read_table(tmp_path / "r.mat")
+    assert table.names == ["u", "y_pos"]
+    np.testing.assert_array_equal(table.data, arr)
+    with pytest.raises(DataError, match="MATLAB variable names"):
+        write_table(tmp_path / "s.mat", ["time [s]", "u"], arr)

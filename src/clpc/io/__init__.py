@@ -1,4 +1,4 @@
-"""Files: tables (CSV, Parquet, npy/npz) in and out, model files.
+"""Files: tables (CSV, Parquet, npy/npz, MATLAB .mat) in and out, model files.
 
 Where each job lives (one module each):
 
@@ -9,6 +9,8 @@ Where each job lives (one module each):
 - ``text_reader``: text files read by ``pyarrow.csv`` block by block, each row's file line
   kept for the messages; ``text_writer``: writing them;
 - ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
+  ``npz_members``: ``.npz`` arrays read a block of rows at a time; ``mat_files``: MATLAB
+  ``.mat`` in and out (``scipy.io``);
 - ``loading``: :func:`read_table`, :func:`iter_table_chunks` (dispatch by extension);
 - ``records``: :func:`load_iodata`; ``writing``: :func:`write_table`;
 - ``model_schema``: the model file schema and :func:`~clpc.io.model_files.model_to_dict`;

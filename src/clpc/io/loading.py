@@ -5,8 +5,9 @@
 
 The reader is chosen by the file's extension (:mod:`clpc.io.formats`): text
 (:mod:`clpc.io.text_reader`), Parquet (:mod:`clpc.io.parquet`), ``.npy``/``.npz``
-(:mod:`clpc.io.numpy_files`). Every reader returns float64 numbers and checks them once; a
-bad file gives a one-line :class:`clpc.data.DataError` (:mod:`clpc.io.errors`).
+(:mod:`clpc.io.numpy_files`), MATLAB ``.mat`` (:mod:`clpc.io.mat_files`). Every reader
+returns float64 numbers and checks them once; a bad file gives a one-line
+:class:`clpc.data.DataError` (:mod:`clpc.io.errors`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from clpc.core.checks import check_int
 from clpc.data import DataError
 from clpc.io.errors import show
 from clpc.io.formats import check_file, file_kind
+from clpc.io.mat_files import mat_source
 from clpc.io.numpy_files import npy_source, npz_source
 from clpc.io.parquet import parquet_source
 from clpc.io.table import Chunks, Columns, PathLike, Table, located_table
@@ -65,6 +67,8 @@ def _open_source(
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
         names, chunks = npy_source(p, columns, allow_missing, whole)
+    elif kind == "mat":
+        names, chunks = mat_source(p, columns, allow_missing)
     else:
         names, chunks = npz_source(p, columns, allow_missing, whole)
     return _Source(p, names, chunks)
@@ -102,7 +106,8 @@ def read_table(
     ----------
     path : str or os.PathLike
         A ``.csv``/``.tsv``/``.tab``/``.txt``/``.dat`` text file (optionally ``.gz``), a
-        ``.parquet``/``.pq``, ``.npy`` or ``.npz`` file.
+        ``.parquet``/``.pq``, ``.npy``, ``.npz`` or MATLAB ``.mat`` file (numeric vectors
+        as columns, or one matrix; :mod:`clpc.io.mat_files`).
     columns : sequence of (str or int), str or int, optional
         Columns to read, by name or 0-based index, in the order wanted (default: all).
         Unselected columns may hold anything (e.g. text); they are not converted.
