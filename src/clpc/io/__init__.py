@@ -6,8 +6,9 @@ Where each job lives (one module each):
 - ``errors``: :class:`DataFileNotFoundError` and the one-line bad-cell messages;
 - ``formats``: which format a file is (by its extension), and that it exists;
 - ``text_format``: delimiter and header detection of text files;
-- ``text_reader``: text files read by ``pyarrow.csv`` block by block, each row's file line
-  kept for the messages; ``text_writer``: writing them;
+- ``text_reader``: text files read by ``pyarrow.csv`` block by block, the first bad cell
+  named by line, column and text; ``text_lines``: the data lines pyarrow is given (blank
+  and comment lines out, each row's file line kept); ``text_writer``: writing text files;
 - ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
   ``npz_members``: ``.npz`` arrays read a block of rows at a time; ``mat_files``: MATLAB
   ``.mat`` in and out (``scipy.io``);

@@ -3,10 +3,8 @@
 pyarrow parses the cells (delimiter, quotes, float64 conversion), block by block. Around it,
 this module keeps each row's file line and one number syntax for every reader:
 
-- :class:`DataLines` hands pyarrow the file from its first data line (gzip decompressed) in
-  blocks cut at line ends. A block with blank lines or ``#`` comments has them taken out
-  (the lines taken out are counted, so that every row knows its file line); the fields of a
-  whitespace-delimited file are joined by tabs.
+- :class:`~clpc.io.text_lines.DataLines` hands pyarrow the data lines without blank and
+  comment lines, and gives every row its line in the file.
 - Columns are read as float64. From the first block where pyarrow refuses a cell, or that
   holds a NaN or inf, the rest of the file is read as text and every cell judged by the
   number syntax of :func:`clpc.io.errors.parse_number`, so that a message names the line,
@@ -16,12 +14,7 @@ this module keeps each row's file line and one number syntax for every reader:
 
 from __future__ import annotations
 
-import gzip
-import io
-import re
-import shutil
 import stat
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -33,125 +26,12 @@ from clpc.data.samples import NUMBER_TEXT
 from clpc.io.errors import cell_error, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 from clpc.io.text_format import READ_ERRORS, TextFormat, read_error, sniff
+from clpc.io.text_lines import BLOCK_BYTES, DataLines, copy_stream
 
-__all__ = ["DataLines", "text_source"]
+__all__ = ["rechunk", "text_source"]
 
-#: bytes handed to pyarrow at a time (and pyarrow's block size)
-BLOCK_BYTES = 1 << 22
-_BLANK_FIRST = re.compile(rb"[ \t\r]*\n")
-_BLANK = re.compile(rb"\n[ \t\r]*\n")
 #: the number syntax of :func:`clpc.io.errors.parse_number`, for pyarrow's RE2
 _NUMBER_RE2 = f"^{NUMBER_TEXT.pattern}$"
-
-
-class DataLines(io.RawIOBase):
-    """The data lines of a text file as a binary stream, without blank and comment lines.
-
-    Parameters
-    ----------
-    path : Path
-        The text file (gzip-compressed when its name ends in ``.gz``).
-    fmt : TextFormat
-        Its layout; reading starts at ``fmt.data_line``.
-
-    Attributes
-    ----------
-    dropped : list of int
-        The 1-based file lines taken out so far (blank or comment lines), in order.
-    """
-
-    def __init__(self, path: Path, fmt: TextFormat) -> None:
-        super().__init__()
-        gz = path.name.lower().endswith(".gz")
-        self._raw: Any = gzip.open(path, "rb") if gz else open(path, "rb")
-        for _ in range(fmt.data_line - 1):
-            self._raw.readline()
-        self._whitespace = fmt.delimiter is None
-        self._first = fmt.data_line == 1
-        self._next_line = fmt.data_line
-        self._pending = b""
-        self._pos = 0
-        self.dropped: list[int] = []
-
-    def readable(self) -> bool:
-        """True: a readable stream."""
-        return True
-
-    def peek(self) -> memoryview:
-        """The cleaned bytes not read yet (empty at the end of the file)."""
-        while self._pos >= len(self._pending) and self._fill():
-            pass
-        return memoryview(self._pending)[self._pos :]
-
-    def _fill(self) -> bool:
-        """Clean the next block into the pending bytes; False at the end of the file."""
-        block = self._raw.read(BLOCK_BYTES)
-        if not block:
-            return False
-        block += self._raw.readline()
-        if self._first:
-            block, self._first = block.removeprefix(b"\xef\xbb\xbf"), False
-        if not block.endswith(b"\n"):
-            block += b"\n"
-        self._pending, self._pos = self._clean(block), 0
-        return True
-
-    def close(self) -> None:
-        """Close the file."""
-        self._raw.close()
-        super().close()
-
-    def read(self, size: int | None = -1) -> bytes:
-        """Up to ``size`` cleaned bytes (all of them when ``size`` is negative or None)."""
-        if size is None or size < 0:
-            parts = []
-            while len(part := self.peek()):
-                parts.append(bytes(part))
-                self._pos = len(self._pending)
-            return b"".join(parts)
-        part = self.peek()[:size]
-        self._pos += len(part)
-        return bytes(part)
-
-    def readinto(self, buffer: Any) -> int:
-        """Fill ``buffer`` with the next cleaned bytes; 0 at the end."""
-        part = self.peek()[: len(buffer)]
-        buffer[: len(part)] = part
-        self._pos += len(part)
-        return len(part)
-
-    def _clean(self, block: bytes) -> bytes:
-        """``block`` (whole lines) without blank and comment lines, whitespace as tabs."""
-        dirty = (
-            b"#" in block
-            or b"\n\n" in block
-            or _BLANK_FIRST.match(block)
-            or ((b"\n\r" in block or b"\n " in block or b"\n\t" in block) and _BLANK.search(block))
-        )
-        if not dirty and not self._whitespace:
-            self._next_line += block.count(b"\n")
-            return block
-        lines = block.split(b"\n")[:-1]
-        out = []
-        for k, line in enumerate(lines):
-            bare = line.strip()
-            if not bare or bare.startswith(b"#"):
-                self.dropped.append(self._next_line + k)
-                continue
-            if b"#" in line and b'"' not in line:
-                line = line[: line.index(b"#")]
-            out.append(b"\t".join(line.split()) if self._whitespace else line)
-        self._next_line += len(lines)
-        return b"\n".join(out) + b"\n" if out else b""
-
-    def lines_of(self, first_row: int, n: int, data_line: int) -> np.ndarray:
-        """The 1-based file lines of data rows ``first_row .. first_row + n - 1``."""
-        rows = np.arange(first_row, first_row + n, dtype=np.int64)
-        if not self.dropped:
-            return rows + data_line
-        # the k-th line taken out comes after (dropped[k] - data_line - k) data rows
-        after = np.asarray(self.dropped, dtype=np.int64) - data_line - np.arange(len(self.dropped))
-        return rows + data_line + np.searchsorted(after, rows, side="right")
 
 
 class _Reader:
@@ -366,7 +246,7 @@ def text_source(
     """
     spool, given = None, path
     if not stat.S_ISREG(path.stat().st_mode):
-        spool, path = _spool(path)
+        spool, path = copy_stream(path)
     fmt = sniff(path, delimiter, header, skip_rows)
     sel = resolve_columns(fmt.names, columns, show(given))
     use = sorted(set(sel))
@@ -381,19 +261,6 @@ def text_source(
             yield from rechunk(reader.batches(), chunk_rows)
 
     return [fmt.names[i] for i in sel], reorder_columns(batches, use, sel)
-
-
-def _spool(path: Path) -> tuple[tempfile.TemporaryDirectory[str], Path]:
-    """A named pipe or device copied to a temporary file, read once (nothing lost).
-
-    The layout is sniffed from the first lines and the data read from the start again:
-    a stream cannot be read twice, so it is copied to disk first (not into memory).
-    """
-    folder = tempfile.TemporaryDirectory(prefix="clpc-")
-    copy = Path(folder.name) / path.name
-    with open(path, "rb") as src, open(copy, "wb") as dst:
-        shutil.copyfileobj(src, dst, 1 << 20)
-    return folder, copy
 
 
 def rechunk(
