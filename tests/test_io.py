@@ -52,7 +52,7 @@ def chunks_concat(path: Path, chunk_rows: int, **kw) -> np.ndarray:
         ('t,u,y\n"0","1.5","-2"\n0.1,2.5,3.25\n0.2,-1e-3,4e5 # last\n', ["t", "u", "y"]),
     ],
 )
-@pytest.mark.parametrize("newline", ["\n", "\r\n"])
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
 def test_text_dialects(tmp_path, text, names, newline):
     path = write(tmp_path / "rec.csv", text, newline)
     table = read_table(path)
@@ -543,3 +543,17 @@ def test_mat_round_trip_and_names(tmp_path):
     np.testing.assert_array_equal(table.data, arr)
     with pytest.raises(DataError, match="MATLAB variable names"):
         write_table(tmp_path / "s.mat", ["time [s]", "u"], arr)
+
+
+def test_long_lines_and_fields_give_short_messages(tmp_path):
+    path = tmp_path / "long.csv"
+    path.write_bytes(b"u,y\n" + b"1,2\n" * 40 + b"3," + b"4" * 500_000 + b"\n5,6\n")
+    with pytest.raises(
+        DataError,
+        match=r"line 42, column 'y': '4{40}\.\.\. \(500,000 characters\)' is not a finite",
+    ) as info:
+        read_table(path)
+    assert len(str(info.value)) < 300
+    path.write_bytes(b"u,y\n1," + b"x" * 200_000 + b"\n")
+    with pytest.raises(DataError, match=r"cannot be split into fields near line 1"):
+        read_table(path)

@@ -50,6 +50,11 @@ class DataLines(io.RawIOBase):
         super().__init__()
         gz = path.name.lower().endswith(".gz")
         self._raw: Any = gzip.open(path, "rb") if gz else open(path, "rb")
+        head = self._raw.read(1 << 16)
+        self._raw.seek(0)
+        if b"\r" in head and b"\n" not in head:  # old Mac line ends: "\r" alone
+            with self._raw:
+                self._raw = io.BytesIO(self._raw.read().replace(b"\r", b"\n"))
         for _ in range(fmt.data_line - 1):
             self._raw.readline()
         self._whitespace = fmt.delimiter is None
