@@ -15,6 +15,7 @@ import io
 import re
 import shutil
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -95,14 +96,16 @@ class DataLines(io.RawIOBase):
     def read(self, size: int | None = -1) -> bytes:
         """Up to ``size`` cleaned bytes (all of them when ``size`` is negative or None)."""
         if size is None or size < 0:
-            parts = []
-            while len(part := self.peek()):
-                parts.append(bytes(part))
-                self._pos = len(self._pending)
-            return b"".join(parts)
+            return b"".join(self.blocks())
         part = self.peek()[:size]
         self._pos += len(part)
         return bytes(part)
+
+    def blocks(self) -> Iterator[bytes]:
+        """The rest of the cleaned bytes, a block of whole lines at a time."""
+        while len(part := self.peek()):
+            self._pos = len(self._pending)
+            yield bytes(part)
 
     def readinto(self, buffer: Any) -> int:
         """Fill ``buffer`` with the next cleaned bytes; 0 at the end."""

@@ -174,12 +174,13 @@ class _Reader:
     def _line_of(self, text: str) -> int | str:
         """The first data line that reads as ``text`` (where pyarrow found a ragged row)."""
         want = text.strip().encode()
-        lines = DataLines(self.path, self.fmt)
-        with lines:
-            data = lines.read()
-        for row, line in enumerate(data.split(b"\n")):
-            if line.strip() == want:
-                return int(lines.lines_of(row, 1, self.fmt.data_line)[0])
+        row = 0
+        with DataLines(self.path, self.fmt) as lines:
+            for block in lines.blocks():
+                for line in block.split(b"\n")[:-1]:
+                    if line.strip() == want:
+                        return int(lines.lines_of(row, 1, self.fmt.data_line)[0])
+                    row += 1
         return "?"
 
 
