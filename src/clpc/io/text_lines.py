@@ -29,6 +29,7 @@ __all__ = ["BLOCK_BYTES", "DataLines", "copy_stream"]
 BLOCK_BYTES = 1 << 22
 _BLANK_FIRST = re.compile(rb"[ \t\r]*\n")
 _BLANK = re.compile(rb"\n[ \t\r]*\n")
+_SPACE = np.frombuffer(b"\n\r \t", dtype=np.uint8)
 
 
 class DataLines(io.RawIOBase):
@@ -116,15 +117,16 @@ class DataLines(io.RawIOBase):
 
     def _clean(self, block: bytes) -> bytes:
         """``block`` (whole lines) without blank and comment lines, whitespace as tabs."""
-        dirty = (
-            b"#" in block
-            or b"\n\n" in block
-            or _BLANK_FIRST.match(block)
-            or ((b"\n\r" in block or b"\n " in block or b"\n\t" in block) and _BLANK.search(block))
-        )
-        if not dirty and not self._whitespace:
-            self._next_line += block.count(b"\n")
-            return block
+        if not self._whitespace and b"#" not in block:
+            # where each line starts: a blank line starts with a line end or white space
+            buf = np.frombuffer(block, dtype=np.uint8)
+            ends = np.flatnonzero(buf == 10)
+            starts = np.concatenate([buf[:1], buf[ends[:-1] + 1]])
+            if not np.isin(starts, _SPACE).any() or not (
+                _BLANK_FIRST.match(block) or _BLANK.search(block)
+            ):
+                self._next_line += ends.size
+                return block
         lines = block.split(b"\n")[:-1]
         out = []
         for k, line in enumerate(lines):
