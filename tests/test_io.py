@@ -557,3 +557,13 @@ def test_long_lines_and_fields_give_short_messages(tmp_path):
     path.write_bytes(b"u,y\n1," + b"x" * 200_000 + b"\n")
     with pytest.raises(DataError, match=r"cannot be split into fields near line 1"):
         read_table(path)
+
+
+def test_the_first_ragged_row_is_named_when_blocks_are_parsed_in_parallel(tmp_path):
+    lines = [f"{k},{k}.5" for k in range(600_000)]
+    lines[20] = "1,2,3"
+    lines[500_000] = "4"
+    path = write(tmp_path / "two.csv", "u,y\n" + "\n".join(lines) + "\n")
+    for read in (read_table, lambda p: chunks_concat(p, 100_000)):
+        with pytest.raises(DataError, match=r"line 22 has 3 field\(s\)"):
+            read(path)

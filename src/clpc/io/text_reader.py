@@ -43,7 +43,7 @@ class _Reader:
         self.path, self.source, self.fmt = path, source, fmt
         self.use = use
         self.allow_missing = allow_missing
-        self.ragged: tuple[int, str] | None = None  # fields and text of a ragged row
+        self.ragged: dict[bytes, int] = {}  # text -> fields of the ragged rows pyarrow met
         self.whole = False  # the caller holds every value at once (read_table)
 
     def _open(self, as_text: bool) -> tuple[DataLines, Any]:
@@ -56,7 +56,7 @@ class _Reader:
         delimiter = "\t" if self.fmt.delimiter is None else self.fmt.delimiter
 
         def ragged(row: Any) -> str:
-            self.ragged = (int(row.actual_columns), str(row.text))
+            self.ragged[str(row.text).strip().encode()] = int(row.actual_columns)
             return "error"
 
         if not lines.peek():
@@ -99,7 +99,7 @@ class _Reader:
                     else:
                         return
             except pa.ArrowInvalid:
-                if self.ragged is not None:
+                if self.ragged:
                     raise self._ragged_error() from None
             yield from self._text_batches(done)
         except READ_ERRORS as exc:
@@ -121,7 +121,7 @@ class _Reader:
                         yield self._judge(batch.slice(skip), where), where
                     done += n
             except pa.ArrowInvalid as exc:
-                if self.ragged is not None:
+                if self.ragged:
                     raise self._ragged_error() from None
                 if "UTF8" in str(exc):
                     raise DataError(
@@ -160,28 +160,28 @@ class _Reader:
 
     def _ragged_error(self) -> DataError:
         fmt = self.fmt
-        got, text = self.ragged or (0, "")
+        line, got = self._first_ragged()
         if fmt.header_line is not None:
             ref = f"the header (line {fmt.header_line})"
         else:
             ref = f"the first data row (line {fmt.data_line})"
         return DataError(
-            f"{self.source} line {self._line_of(text)} has {got} field(s) but {ref} has "
+            f"{self.source} line {line} has {got} field(s) but {ref} has "
             f"{fmt.n_cols} (delimiter {fmt.describe_delimiter()}); fix or remove that row, or "
             "pass delimiter= if the separator was guessed wrongly."
         )
 
-    def _line_of(self, text: str) -> int | str:
-        """The first data line that reads as ``text`` (where pyarrow found a ragged row)."""
-        want = text.strip().encode()
+    def _first_ragged(self) -> tuple[int | str, int]:
+        """Line and field count of the first ragged row (pyarrow's threads give its text)."""
         row = 0
         with DataLines(self.path, self.fmt) as lines:
             for block in lines.blocks():
                 for line in block.split(b"\n")[:-1]:
-                    if line.strip() == want:
-                        return int(lines.lines_of(row, 1, self.fmt.data_line)[0])
+                    got = self.ragged.get(line.strip())
+                    if got is not None:
+                        return int(lines.lines_of(row, 1, self.fmt.data_line)[0]), got
                     row += 1
-        return "?"
+        return "?", next(iter(self.ragged.values()))
 
 
 def _float_batch(batch: Any) -> tuple[np.ndarray, np.ndarray]:
