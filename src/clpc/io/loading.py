@@ -178,12 +178,11 @@ def iter_table_chunks(
     path : str or os.PathLike
         As for :func:`read_table`.
     chunk_rows : int
-        Rows per chunk (>= 1). Parquet and ``.npy``/``.npz`` chunks have exactly
-        ``chunk_rows`` rows (the last one fewer); a text chunk holds the data rows among
-        ``chunk_rows`` consecutive lines (fewer when blank or comment lines occur).
-        Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
-        memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
-        array in Fortran order and the pandas fallback for Parquet are loaded whole.
+        Rows per chunk (>= 1): every chunk has exactly ``chunk_rows`` rows (the last one
+        fewer), whatever the format and however many blank or comment lines. Text, Parquet,
+        ``.npy`` and ``.npz`` files are read piece by piece (``.npy`` memory-mapped, ``.npz``
+        members decompressed a chunk at a time); a 2-D ``.npz`` array in Fortran order and
+        the selected variables of a ``.mat`` file are loaded whole (within the load limit).
     columns, delimiter, header, allow_missing, skip_rows
         As for :func:`read_table`.
 
