@@ -255,11 +255,13 @@ def text_source(
     reader.whole = whole
 
     def batches(chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        # read_table joins pyarrow's blocks as they come; iter_table_chunks re-cuts them
+        blocks = reader.batches() if whole else rechunk(reader.batches(), chunk_rows)
         if spool is None:
-            yield from rechunk(reader.batches(), chunk_rows)
+            yield from blocks
             return
         with spool:  # removed once read
-            yield from rechunk(reader.batches(), chunk_rows)
+            yield from blocks
 
     return [fmt.names[i] for i in sel], reorder_columns(batches, use, sel)
 
