@@ -2,10 +2,9 @@
 
 Side by side in one run, each the best of ``--repeat`` (the two paths alternating):
 
-* reading a 1e6 x 2 CSV with ``clpc.io.read_table``: the plain reader (``fast=False``:
-  ``numpy.loadtxt`` in batches, Python for the messages) against the default path (pyarrow
-  when installed); ``pandas.read_csv`` and ``pyarrow.csv.read_csv`` as outside references.
-  The values must be identical.
+* reading a 1e6 x 2 CSV with ``clpc.io.read_table`` and ``iter_table_chunks`` (``pyarrow.csv``
+  with the line bookkeeping for messages); ``pandas.read_csv`` and ``pyarrow.csv.read_csv`` as
+  outside references. The values must equal ``numpy.loadtxt``'s.
 * ``python -m clpc track`` on the same file (subprocesses, all variants alternating):
   ``CLPC_FAST_IO=0`` (plain reader and the plain trace writer) and the default, and with
   ``--baseline-src`` the package before issue 16 (commit 64b4459) as well; every
@@ -16,6 +15,7 @@ Side by side in one run, each the best of ``--repeat`` (the two paths alternatin
 
     python benchmarks/bench_io.py               # 1e6 rows
     python benchmarks/bench_io.py --rows 2e5    # quick
+    python benchmarks/bench_io.py --only-read   # the CSV read only
     git worktree add /tmp/clpc-old 64b4459      # the package before issue 16, then:
     python benchmarks/bench_io.py --baseline-src /tmp/clpc-old/src --skip-read --repeat 5
 """
@@ -54,29 +54,26 @@ def run(cmd: list[str], env: dict[str, str] | None = None) -> float:
 
 
 def bench_read(path: str, repeat: int) -> None:
-    from clpc.io import read_table
+    from clpc.io import iter_table_chunks, read_table
 
     read_table(path)  # pyarrow's import, once
-    plain, fast = [], []
-    for _ in range(repeat):  # alternating
-        plain.append(best_of(lambda: read_table(path, fast=False), 1))
-        fast.append(best_of(lambda: read_table(path), 1))
-    a, b = read_table(path, fast=False), read_table(path)
-    same = np.array_equal(a.data, b.data) and a.names == b.names
-    print(f"## read_table, {a.n_rows} x {a.n_columns} CSV ({os.path.getsize(path) / 1e6:.1f} MB)")
-    print(f"plain reader (fast=False): {min(plain):.3f} s")
-    print(f"default (pyarrow):         {min(fast):.3f} s   -> {min(plain) / min(fast):.1f}x faster")
-    print(f"values identical: {same}")
-    try:
-        import pandas as pd
+    whole = best_of(lambda: read_table(path), repeat)
+    chunked = best_of(lambda: sum(v.shape[0] for _, v in iter_table_chunks(path)), repeat)
+    table = read_table(path)
+    same = np.array_equal(table.data, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2))
+    print(
+        f"## read_table, {table.n_rows} x {table.n_columns} CSV "
+        f"({os.path.getsize(path) / 1e6:.1f} MB)"
+    )
+    print(f"read_table (pyarrow.csv):        {whole:.3f} s")
+    print(f"iter_table_chunks (100k rows):   {chunked:.3f} s")
+    print(f"values identical to numpy.loadtxt: {same}")
+    import pandas as pd
+    from pyarrow import csv
 
-        print(f"(pandas.read_csv:          {best_of(lambda: pd.read_csv(path), repeat):.3f} s)")
-        from pyarrow import csv
-
-        print(f"(pyarrow.csv.read_csv:     {best_of(lambda: csv.read_csv(path), repeat):.3f} s)")
-    except ImportError:
-        pass
-    assert same, "the fast path changed the values"
+    print(f"(pandas.read_csv:                {best_of(lambda: pd.read_csv(path), repeat):.3f} s)")
+    print(f"(pyarrow.csv.read_csv:           {best_of(lambda: csv.read_csv(path), repeat):.3f} s)")
+    assert same, "the reader changed the values"
 
 
 def bench_track(path: str, repeat: int, work: Path, baseline_src: str | None) -> None:
@@ -182,6 +179,7 @@ def main() -> None:
         "is timed beside the others (PYTHONPATH of the subprocess)",
     )
     ap.add_argument("--skip-read", action="store_true", help="only `clpc track` and start-up")
+    ap.add_argument("--only-read", action="store_true", help="only the CSV read")
     args = ap.parse_args()
     import clpc
 
@@ -197,6 +195,8 @@ def main() -> None:
         write_record(path, int(args.rows))
         if not args.skip_read:
             bench_read(path, args.repeat)
+        if args.only_read:
+            return
         bench_track(path, args.repeat, work, args.baseline_src)
     bench_startup(5 * args.repeat)
 

@@ -1,6 +1,6 @@
 """Data in: a jittery time column, time units, resampling on request, metadata and units
-rows, the pyarrow fast path (same values and the same messages as the plain reader), and
-trace files with integers as integers."""
+rows, the pyarrow reader (exact values, messages naming the line, the column and the text),
+and trace files with integers as integers."""
 
 from __future__ import annotations
 
@@ -140,11 +140,9 @@ def _messy(tmp_path):
     return path, values
 
 
-def test_fast_path_gives_the_plain_readers_values(tmp_path):
+def test_the_reader_gives_the_written_values(tmp_path):
     path, values = _messy(tmp_path)
-    fast, plain = read_table(path), read_table(path, fast=False)
-    np.testing.assert_array_equal(fast.data, values)
-    np.testing.assert_array_equal(plain.data, values)
+    np.testing.assert_array_equal(read_table(path).data, values)
     sel = read_table(path, columns=["c", "a"])
     np.testing.assert_array_equal(sel.data, values[:, [2, 0]])
     chunks = [v for _, v in iter_table_chunks(path, 700, columns=["b"])]
@@ -161,15 +159,14 @@ def test_fast_path_gives_the_plain_readers_values(tmp_path):
         ("1.0,nan,3.0", r"line 7, column 'b': 'nan'"),
     ],
 )
-def test_fast_path_keeps_the_line_and_column_messages(tmp_path, line, pattern):
+def test_bad_cells_are_named_by_line_and_column(tmp_path, line, pattern):
     path = tmp_path / "bad.csv"
     good = "".join(f"{k}.0,{k}.5,{k}.25\n" for k in range(5))
     path.write_text("a,b,c\n" + good + line + "\n" + good)
-    for fast in (True, False):
-        with pytest.raises(DataError, match=pattern):
-            read_table(path, fast=fast)
-        with pytest.raises(DataError, match=pattern):
-            list(iter_table_chunks(path, 3, fast=fast))
+    with pytest.raises(DataError, match=pattern):
+        read_table(path)
+    with pytest.raises(DataError, match=pattern):
+        list(iter_table_chunks(path, 3))
 
 
 #: cells pyarrow parses differently from clpc's one number syntax, and ordinary ones
@@ -198,8 +195,8 @@ SYNTAX_CELLS = [
 
 @pytest.mark.parametrize("allow_missing", [False, True])
 @pytest.mark.parametrize("cell", SYNTAX_CELLS)
-def test_fast_path_applies_the_one_number_syntax(tmp_path, cell, allow_missing):
-    """Fast and plain readers agree with :func:`clpc.io.errors.parse_number` on every cell."""
+def test_the_reader_applies_the_one_number_syntax(tmp_path, cell, allow_missing):
+    """The text reader agrees with :func:`clpc.io.errors.parse_number` on every cell."""
     from clpc.io.errors import parse_number
 
     path = tmp_path / "s.csv"
@@ -209,16 +206,15 @@ def test_fast_path_applies_the_one_number_syntax(tmp_path, cell, allow_missing):
     except ValueError:
         value = None
     refused = value is None or (not allow_missing and not np.isfinite(value))
-    for fast in (True, False):
-        if refused:
-            with pytest.raises(DataError, match=r"line 4, column 'b'"):
-                read_table(path, allow_missing=allow_missing, fast=fast)
-        else:
-            got = read_table(path, allow_missing=allow_missing, fast=fast).data
-            np.testing.assert_array_equal(got, [[1, 2], [3, 4], [5, value], [7, 8]])
+    if refused:
+        with pytest.raises(DataError, match=r"line 4, column 'b'"):
+            read_table(path, allow_missing=allow_missing)
+    else:
+        got = read_table(path, allow_missing=allow_missing).data
+        np.testing.assert_array_equal(got, [[1, 2], [3, 4], [5, value], [7, 8]])
 
 
-def test_comments_and_blank_lines_fall_back_to_the_plain_reader(tmp_path):
+def test_comments_and_blank_lines_keep_the_line_numbers(tmp_path):
     path = tmp_path / "c.csv"
     path.write_text("# a comment\na,b\n1,2\n\n3,4 # note\n# more\n5,6\n")
     table = read_table(path)
@@ -251,8 +247,9 @@ def test_trace_csv_has_integers_as_integers(tmp_path, monkeypatch, fast_io):
 def test_blank_lines_keep_the_line_numbers(tmp_path, text):
     path = tmp_path / "blank.csv"
     path.write_text(text)
-    fast, plain = read_table(path), read_table(path, fast=False)
-    np.testing.assert_array_equal(fast.data, [[1, 2], [3, 4], [5, 6]])
-    labels = [fast.row_label(i) for i in range(3)]
-    assert labels == [plain.row_label(i) for i in range(3)]
-    assert labels[1] == ("line 4" if "\n\n3" in text else "line 3")
+    table = read_table(path)
+    np.testing.assert_array_equal(table.data, [[1, 2], [3, 4], [5, 6]])
+    labels = [table.row_label(i) for i in range(3)]
+    assert labels == (
+        ["line 2", "line 4", "line 5"] if "\n\n3" in text else ["line 2", "line 3", "line 4"]
+    )

@@ -20,7 +20,6 @@ from clpc.io import (
     read_table,
     write_table,
 )
-from clpc.io import parquet as io_parquet
 
 VALUES = np.array([[0.0, 1.5, -2.0], [0.1, 2.5, 3.25], [0.2, -1e-3, 4e5]])
 
@@ -53,7 +52,7 @@ def chunks_concat(path: Path, chunk_rows: int, **kw) -> np.ndarray:
         ('t,u,y\n"0","1.5","-2"\n0.1,2.5,3.25\n0.2,-1e-3,4e5 # last\n', ["t", "u", "y"]),
     ],
 )
-@pytest.mark.parametrize("newline", ["\n", "\r\n"])
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
 def test_text_dialects(tmp_path, text, names, newline):
     path = write(tmp_path / "rec.csv", text, newline)
     table = read_table(path)
@@ -235,7 +234,7 @@ def test_npz_layouts(tmp_path):
         read_table(tmp_path / "bad.npz")
 
 
-def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
+def test_parquet_types_nulls_and_chunks(tmp_path):
     pa = pytest.importorskip("pyarrow")
     pq = pytest.importorskip("pyarrow.parquet")
     stamps = np.datetime64("2024-01-01T00:00:00", "ns") + np.arange(4) * np.timedelta64(10, "ms")
@@ -259,21 +258,9 @@ def test_parquet_types_nulls_and_pandas_fallback(tmp_path, monkeypatch):
         read_table(path, columns=["gap"])
     data = load_iodata(path, "u", "flag", time_column="t")
     assert data.dt == 0.01
-    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)  # pandas path
-    np.testing.assert_array_equal(read_table(path, columns=["u", "flag"]).data, got.data[:, 1:])
-    with pytest.raises(DataError, match=r"row 2, column 'gap'"):
-        read_table(path, columns=["gap"])
-
-
-def test_parquet_without_pyarrow_or_pandas(tmp_path, monkeypatch):
-    path = tmp_path / "x.parquet"
-    path.write_bytes(b"PAR1")
-    monkeypatch.setattr(io_parquet, "_import_pyarrow", lambda: None)
-    monkeypatch.setattr(io_parquet, "_import_pandas", lambda: None)
-    with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):
-        read_table(path)
-    with pytest.raises(ImportError, match=r"pip install 'clpc\[frames\]'"):
-        write_table(tmp_path / "y.parquet", ["u"], [1.0])
+    chunks = [v for _, v in iter_table_chunks(path, 3, columns=["u", "flag"])]
+    assert [c.shape[0] for c in chunks] == [3, 1]
+    np.testing.assert_array_equal(np.concatenate(chunks), got.data[:, 1:])
 
 
 # ------------------------------------------------------------------------ errors
@@ -454,3 +441,129 @@ def test_table_basics():
     assert "Table(n_rows=2" in repr(table)
     with pytest.raises(DataError, match="one name per column"):
         Table(["a"], [[1, 2]])
+
+
+# ------------------------------------------------- the pyarrow reader's line numbers
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("u y\n1 2\n\n# c\n3\n", r"line 5 has 1 field\(s\) but the header \(line 1\)"),
+        ("u,y\n# c,d\n1,2\n\n3,4,5\n", r"line 5 has 3 field\(s\)"),
+        ("u y\n1 2\n  # note\n\n3 x\n", r"line 5, column 'y': 'x' is not a number"),
+        ("u\n1\n\n   \n# c\nabc\n", r"line 6, column 'u': 'abc' is not a number"),
+    ],
+)
+def test_blank_and_comment_lines_keep_error_lines(tmp_path, text, match):
+    path = write(tmp_path / "w.txt", text)
+    with pytest.raises(DataError, match=match):
+        read_table(path)
+    with pytest.raises(DataError, match=match):
+        chunks_concat(path, 1)
+
+
+def test_one_column_and_whitespace_files_skip_blank_and_comment_lines(tmp_path):
+    path = write(tmp_path / "one.csv", "u\n1\n\n   \n# c\n2 # two\n")
+    table = read_table(path)
+    assert table.data[:, 0].tolist() == [1, 2]
+    assert [table.row_label(i) for i in range(2)] == ["line 2", "line 6"]
+    path = write(tmp_path / "ws.dat", "t u\n# c\n 0\t1.5 \n\n1   2.5\n")
+    assert read_table(path).data.tolist() == [[0, 1.5], [1, 2.5]]
+
+
+def test_bad_cell_in_a_later_block_names_its_line(tmp_path):
+    n = 400_000  # more than one pyarrow block
+    lines = [f"{k},{k}.5" for k in range(n)]
+    lines[n - 10] = "1,bad"
+    lines.insert(100, "# a comment")
+    path = write(tmp_path / "big.csv", "u,y\n" + "\n".join(lines) + "\n")
+    with pytest.raises(DataError, match=rf"line {n - 10 + 3}, column 'y': 'bad'"):
+        read_table(path)
+    lines[n - 9] = f"{n - 10},{n - 10}.5"
+    path = write(tmp_path / "big.csv", "u,y\n" + "\n".join(lines) + "\n")
+    table = read_table(path, allow_missing=True)
+    assert table.n_rows == n and table.row_label(n - 1) == f"line {n + 2}"
+
+
+# ------------------------------------------------------------------ MATLAB files
+def test_mat_variables_are_columns(tmp_path):
+    from scipy.io import savemat
+
+    t = np.arange(6) * 0.1
+    u = np.sin(t)
+    y = np.arange(6, dtype=np.int16)
+    path = tmp_path / "rec.mat"
+    savemat(path, {"t": t, "u": u[:, None], "y": y, "dt": 0.1, "note": "bench run 3"})
+    table = read_table(path)
+    assert table.names == ["t", "u", "y"]  # scalar dt and text note left out
+    np.testing.assert_array_equal(table.data, np.column_stack([t, u, y]))
+    assert table.row_label(0) == "row 1"
+    data = load_iodata(path, "u", "y", time_column="t")
+    assert data.dt == pytest.approx(0.1)
+    np.testing.assert_array_equal(chunks_concat(path, 4, columns=["y", "t"]), table.data[:, [2, 0]])
+
+
+def test_mat_matrix_names_and_errors(tmp_path):
+    from scipy.io import savemat
+
+    arr = np.arange(12.0).reshape(4, 3)
+    savemat(tmp_path / "m.mat", {"data": arr, "columns": np.array(["a", "b", "c"], dtype=object)})
+    table = read_table(tmp_path / "m.mat", columns=["c", "a"])
+    assert table.names == ["c", "a"]
+    np.testing.assert_array_equal(table.data, arr[:, [2, 0]])
+    savemat(tmp_path / "plain.mat", {"X": arr})
+    assert read_table(tmp_path / "plain.mat").names == ["col0", "col1", "col2"]
+    bad = arr.copy()
+    bad[2, 1] = np.nan
+    savemat(tmp_path / "nan.mat", {"u": bad[:, 0], "y": bad[:, 1]})
+    with pytest.raises(DataError, match=r"row 3, column 'y': 'nan' is not a finite"):
+        read_table(tmp_path / "nan.mat")
+    savemat(tmp_path / "len.mat", {"u": np.ones(3), "y": np.ones(4)})
+    with pytest.raises(DataError, match="differ in length: 'y' has 4 rows but 'u' has 3"):
+        read_table(tmp_path / "len.mat")
+    savemat(tmp_path / "mix.mat", {"u": np.ones(3), "X": np.ones((3, 2))})
+    with pytest.raises(DataError, match="either one 2-D matrix or numeric vectors"):
+        read_table(tmp_path / "mix.mat")
+    savemat(tmp_path / "cplx.mat", {"u": np.ones(3) + 1j})
+    with pytest.raises(DataError, match="complex"):
+        read_table(tmp_path / "cplx.mat")
+    write(tmp_path / "junk.mat", "not a mat file at all")
+    with pytest.raises(DataError, match=r"not a valid \.mat file"):
+        read_table(tmp_path / "junk.mat")
+    hdf = tmp_path / "v73.mat"
+    hdf.write_bytes(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116) + bytes(8) + b"\x00\x02IM")
+    with pytest.raises(DataError, match=r"v7\.3"):
+        read_table(hdf)
+
+
+def test_mat_round_trip_and_names(tmp_path):
+    arr = np.random.default_rng(4).standard_normal((50, 2))
+    write_table(tmp_path / "r.mat", ["u", "y_pos"], arr)
+    table = read_table(tmp_path / "r.mat")
+    assert table.names == ["u", "y_pos"]
+    np.testing.assert_array_equal(table.data, arr)
+    with pytest.raises(DataError, match="MATLAB variable names"):
+        write_table(tmp_path / "s.mat", ["time [s]", "u"], arr)
+
+
+def test_long_lines_and_fields_give_short_messages(tmp_path):
+    path = tmp_path / "long.csv"
+    path.write_bytes(b"u,y\n" + b"1,2\n" * 40 + b"3," + b"4" * 500_000 + b"\n5,6\n")
+    with pytest.raises(
+        DataError,
+        match=r"line 42, column 'y': '4{40}\.\.\. \(500,000 characters\)' is not a finite",
+    ) as info:
+        read_table(path)
+    assert len(str(info.value)) < 300
+    path.write_bytes(b"u,y\n1," + b"x" * 200_000 + b"\n")
+    with pytest.raises(DataError, match=r"cannot be split into fields near line 1"):
+        read_table(path)
+
+
+def test_the_first_ragged_row_is_named_when_blocks_are_parsed_in_parallel(tmp_path):
+    lines = [f"{k},{k}.5" for k in range(600_000)]
+    lines[20] = "1,2,3"
+    lines[500_000] = "4"
+    path = write(tmp_path / "two.csv", "u,y\n" + "\n".join(lines) + "\n")
+    for read in (read_table, lambda p: chunks_concat(p, 100_000)):
+        with pytest.raises(DataError, match=r"line 22 has 3 field\(s\)"):
+            read(path)

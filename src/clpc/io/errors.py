@@ -80,6 +80,7 @@ def cell_error(where: str, column: str, text: str, source: str) -> DataError:
         A one-line message naming the place, the column and the fix.
     """
     text = text.strip()
+    shown = text if len(text) <= 60 else f"{text[:40]}... ({len(text):,} characters)"
     if not text:
         return DataError(
             f"{source} {where}, column {column!r}: empty cell (a missing value); fill or "
@@ -87,14 +88,14 @@ def cell_error(where: str, column: str, text: str, source: str) -> DataError:
         )
     if is_number(text):  # nan or inf
         return DataError(
-            f"{source} {where}, column {column!r}: {text!r} is not a finite number; remove "
+            f"{source} {where}, column {column!r}: {shown!r} is not a finite number; remove "
             "or interpolate missing samples before identification."
         )
     hint = ""
     if re.fullmatch(r"[+-]?\d+,\d+([eE][+-]?\d+)?", text):
         hint = " Decimal commas are not supported: use '.' as the decimal point."
     return DataError(
-        f"{source} {where}, column {column!r}: {text!r} is not a number; fix the cell or "
+        f"{source} {where}, column {column!r}: {shown!r} is not a number; fix the cell or "
         f"leave the column out of the selection.{hint}"
     )
 

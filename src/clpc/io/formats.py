@@ -14,9 +14,9 @@ __all__ = ["PARQUET_EXTS", "SUPPORTED", "TEXT_EXTS", "Kind", "check_file", "file
 
 TEXT_EXTS = (".csv", ".tsv", ".tab", ".txt", ".dat")
 PARQUET_EXTS = (".parquet", ".pq")
-SUPPORTED = (*TEXT_EXTS, *(e + ".gz" for e in TEXT_EXTS), *PARQUET_EXTS, ".npy", ".npz")
+SUPPORTED = (*TEXT_EXTS, *(e + ".gz" for e in TEXT_EXTS), *PARQUET_EXTS, ".npy", ".npz", ".mat")
 
-Kind = Literal["text", "parquet", "npy", "npz"]
+Kind = Literal["text", "parquet", "npy", "npz", "mat"]
 
 
 def file_kind(path: Path) -> Kind:
@@ -36,6 +36,8 @@ def file_kind(path: Path) -> Kind:
         return "npy"
     if name.endswith(".npz"):
         return "npz"
+    if name.endswith(".mat"):
+        return "mat"
     ext = "".join(path.suffixes[-2:]) if path.suffix.lower() == ".gz" else path.suffix
     hint = ""
     if ext.lower() in (".xlsx", ".xls", ".ods"):

@@ -5,8 +5,9 @@
 
 The reader is chosen by the file's extension (:mod:`clpc.io.formats`): text
 (:mod:`clpc.io.text_reader`), Parquet (:mod:`clpc.io.parquet`), ``.npy``/``.npz``
-(:mod:`clpc.io.numpy_files`). Every reader returns float64 numbers and checks them once; a
-bad file gives a one-line :class:`clpc.data.DataError` (:mod:`clpc.io.errors`).
+(:mod:`clpc.io.numpy_files`), MATLAB ``.mat`` (:mod:`clpc.io.mat_files`). Every reader
+returns float64 numbers and checks them once; a bad file gives a one-line
+:class:`clpc.data.DataError` (:mod:`clpc.io.errors`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from clpc.core.checks import check_int
 from clpc.data import DataError
 from clpc.io.errors import show
 from clpc.io.formats import check_file, file_kind
+from clpc.io.mat_files import mat_source
 from clpc.io.numpy_files import npy_source, npz_source
 from clpc.io.parquet import parquet_source
 from clpc.io.table import Chunks, Columns, PathLike, Table, located_table
@@ -47,7 +49,6 @@ def _open_source(
     header: bool | None,
     allow_missing: bool,
     skip_rows: int = 0,
-    fast: bool = True,
     whole: bool = False,
 ) -> _Source:
     """Check the file, resolve the columns and pick the reader of the file's format.
@@ -61,11 +62,13 @@ def _open_source(
     if skip and kind != "text":
         raise DataError(f"skip_rows applies to text files only; {show(p)} is a {kind} file.")
     if kind == "text":
-        names, chunks = text_source(p, columns, delimiter, header, allow_missing, skip, fast)
+        names, chunks = text_source(p, columns, delimiter, header, allow_missing, skip, whole)
     elif kind == "parquet":
         names, chunks = parquet_source(p, columns, allow_missing)
     elif kind == "npy":
         names, chunks = npy_source(p, columns, allow_missing, whole)
+    elif kind == "mat":
+        names, chunks = mat_source(p, columns, allow_missing)
     else:
         names, chunks = npz_source(p, columns, allow_missing, whole)
     return _Source(p, names, chunks)
@@ -96,7 +99,6 @@ def read_table(
     header: bool | None = None,
     allow_missing: bool = False,
     skip_rows: int = 0,
-    fast: bool = True,
 ) -> Table:
     """Read a whole data file into a :class:`Table`.
 
@@ -104,7 +106,8 @@ def read_table(
     ----------
     path : str or os.PathLike
         A ``.csv``/``.tsv``/``.tab``/``.txt``/``.dat`` text file (optionally ``.gz``), a
-        ``.parquet``/``.pq``, ``.npy`` or ``.npz`` file.
+        ``.parquet``/``.pq``, ``.npy``, ``.npz`` or MATLAB ``.mat`` file (numeric vectors
+        as columns, or one matrix; :mod:`clpc.io.mat_files`).
     columns : sequence of (str or int), str or int, optional
         Columns to read, by name or 0-based index, in the order wanted (default: all).
         Unselected columns may hold anything (e.g. text); they are not converted.
@@ -120,10 +123,6 @@ def read_table(
     skip_rows : int
         Text files only: physical lines to pass over at the top (e.g. a metadata line).
         A units row right under the header (``s,m,m,V``) is skipped without asking.
-    fast : bool
-        Text files only: parse through pyarrow when it is installed (default), with the
-        plain reader taking over - and naming the line, column and text - wherever pyarrow
-        cannot vouch for a value (:mod:`clpc.io.arrow_text`). ``False``: the plain reader.
 
     Returns
     -------
@@ -138,10 +137,8 @@ def read_table(
     DataError
         Unsupported extension, empty file, unknown column, ragged row, non-numeric or
         missing cell (the message names the line/row, the column and the text).
-    ImportError
-        Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
-    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast, whole=True)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
     for values, where in src.chunks(_READ_CHUNK):
@@ -170,7 +167,6 @@ def iter_table_chunks(
     header: bool | None = None,
     allow_missing: bool = False,
     skip_rows: int = 0,
-    fast: bool = True,
 ) -> Iterator[tuple[list[str], np.ndarray]]:
     """Read a data file piece by piece, without holding it all in memory.
 
@@ -182,13 +178,12 @@ def iter_table_chunks(
     path : str or os.PathLike
         As for :func:`read_table`.
     chunk_rows : int
-        Rows per chunk (>= 1). Parquet and ``.npy``/``.npz`` chunks have exactly
-        ``chunk_rows`` rows (the last one fewer); a text chunk holds the data rows among
-        ``chunk_rows`` consecutive lines (fewer when blank or comment lines occur).
-        Text, Parquet, ``.npy`` and ``.npz`` files are read piece by piece (``.npy``
-        memory-mapped, ``.npz`` members decompressed a chunk at a time); a 2-D ``.npz``
-        array in Fortran order and the pandas fallback for Parquet are loaded whole.
-    columns, delimiter, header, allow_missing, skip_rows, fast
+        Rows per chunk (>= 1): every chunk has exactly ``chunk_rows`` rows (the last one
+        fewer), whatever the format and however many blank or comment lines. Text, Parquet,
+        ``.npy`` and ``.npz`` files are read piece by piece (``.npy`` memory-mapped, ``.npz``
+        members decompressed a chunk at a time); a 2-D ``.npz`` array in Fortran order and
+        the selected variables of a ``.mat`` file are loaded whole (within the load limit).
+    columns, delimiter, header, allow_missing, skip_rows
         As for :func:`read_table`.
 
     Yields
@@ -204,7 +199,7 @@ def iter_table_chunks(
         As :func:`read_table`; errors in later rows surface when that chunk is reached.
     """
     chunk_rows = _check_chunk_rows(chunk_rows)
-    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, fast)
+    src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows)
 
     def generate() -> Iterator[tuple[list[str], np.ndarray]]:
         empty = True

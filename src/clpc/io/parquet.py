@@ -1,8 +1,7 @@
-"""Parquet files (``.parquet``, ``.pq``) in and out.
+"""Parquet files (``.parquet``, ``.pq``) in and out, through ``pyarrow.parquet``.
 
-Needs pyarrow (or pandas with a Parquet engine): ``pip install 'clpc[frames]'``. Numeric
-and boolean columns are read as float64; timestamp and duration columns as seconds since
-the first row. pyarrow reads the file batch by batch; the pandas fallback loads it whole.
+Numeric and boolean columns are read as float64; timestamp and duration columns as seconds
+since the first row. The file is read batch by batch (``ParquetFile.iter_batches``).
 """
 
 from __future__ import annotations
@@ -20,31 +19,7 @@ from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
 
 __all__ = ["parquet_source", "write_parquet"]
 
-_FRAMES_HINT = "pip install 'clpc[frames]'"
 _PER_SECOND = {"s": 1, "ms": 10**3, "us": 10**6, "ns": 10**9}
-
-
-def _import_pyarrow() -> tuple[ModuleType, ModuleType, ModuleType] | None:
-    """``(pyarrow, pyarrow.parquet, pyarrow.compute)`` or None when pyarrow is missing."""
-    try:
-        import pyarrow as pa
-        import pyarrow.compute as pc
-        import pyarrow.parquet as pq
-    except ImportError:
-        return None
-    return pa, pq, pc
-
-
-def _import_pandas() -> ModuleType | None:
-    try:
-        import pandas as pd
-    except ImportError:
-        return None
-    return pd
-
-
-def _missing_frames(what: str) -> ImportError:
-    return ImportError(f"{what} needs pyarrow (or pandas with a Parquet engine): {_FRAMES_HINT}")
 
 
 class _ArrowColumns:
@@ -109,13 +84,11 @@ def parquet_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[l
     ------
     DataError
         An unreadable or empty file, a non-numeric column, a missing or bad cell.
-    ImportError
-        Neither pyarrow nor pandas with a Parquet engine is installed.
     """
-    mods = _import_pyarrow()
-    if mods is None:
-        return _pandas_source(path, columns, allow_missing)
-    pa, pq, pc = mods
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
     source = show(path)
     try:
         pf = pq.ParquetFile(path)
@@ -146,51 +119,6 @@ def parquet_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[l
     return [all_names[i] for i in sel], reorder_columns(chunks, use, sel)
 
 
-def _pandas_column(pd: ModuleType, series: Any, name: str, source: str) -> np.ndarray:
-    """One pandas column as float64 (time stamps and durations: seconds since row 1)."""
-    if pd.api.types.is_datetime64_any_dtype(series) or pd.api.types.is_timedelta64_dtype(series):
-        return np.asarray((series - series.iloc[0]).dt.total_seconds().to_numpy())
-    try:
-        return np.asarray(series.to_numpy(dtype=np.float64, na_value=np.nan))
-    except (TypeError, ValueError):
-        for k, text in enumerate(series.tolist()):
-            if not is_number(str(text)):
-                raise cell_error(f"row {k + 1}", name, str(text), source) from None
-        raise
-
-
-def _pandas_source(path: Path, columns: Columns, allow_missing: bool) -> tuple[list[str], Chunks]:
-    """:func:`parquet_source` without pyarrow: pandas loads the whole file."""
-    source = show(path)
-    pd = _import_pandas()
-    if pd is None:
-        raise _missing_frames(f"reading Parquet ({source})")
-    try:
-        frame = pd.read_parquet(path)
-    except ImportError:
-        raise _missing_frames(f"reading Parquet ({source})") from None
-    all_names = [str(c) for c in frame.columns]
-    sel = resolve_columns(all_names, columns, source)
-    use = sorted(set(sel))
-    if len(frame) == 0:
-        raise DataError(f"data file {source} is empty (0 rows); it needs at least one row.")
-    cols = []
-    for i in use:
-        series = frame.iloc[:, i]
-        if not allow_missing and series.isna().any():
-            first = int(np.flatnonzero(series.isna().to_numpy())[0])
-            raise cell_error(f"row {first + 1}", all_names[i], "", source)
-        cols.append(_pandas_column(pd, series, all_names[i], source))
-    values = np.column_stack(cols)
-    check_values(values, 0, [all_names[i] for i in use], source, allow_missing)
-
-    def chunks(chunk_rows: int) -> Iterator[tuple[np.ndarray, None]]:
-        for start in range(0, values.shape[0], chunk_rows):
-            yield values[start : start + chunk_rows], None
-
-    return [all_names[i] for i in sel], reorder_columns(chunks, use, sel)
-
-
 def write_parquet(path: Path, names: list[str], arr: np.ndarray) -> None:
     """Write named float64 columns to a Parquet file.
 
@@ -203,21 +131,9 @@ def write_parquet(path: Path, names: list[str], arr: np.ndarray) -> None:
     arr : ndarray, shape (n_rows, n_columns)
         float64 values.
 
-    Raises
-    ------
-    ImportError
-        Neither pyarrow nor pandas with a Parquet engine is installed.
     """
-    mods = _import_pyarrow()
-    if mods is not None:
-        pa, pq, _ = mods
-        table = pa.Table.from_arrays([pa.array(arr[:, k]) for k in range(arr.shape[1])], names)
-        pq.write_table(table, path)
-        return
-    pd = _import_pandas()
-    if pd is None:
-        raise _missing_frames(f"writing Parquet ({show(path)})")
-    try:
-        pd.DataFrame(arr, columns=names).to_parquet(path)
-    except ImportError:
-        raise _missing_frames(f"writing Parquet ({show(path)})") from None
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_arrays([pa.array(arr[:, k]) for k in range(arr.shape[1])], names)
+    pq.write_table(table, path)

@@ -218,6 +218,19 @@ def sniff(path: Path, delimiter: str | None, header: bool | None, skip_rows: int
         An empty file, a file that is not UTF-8 text, or an invalid ``delimiter``.
     """
     comments, content = _first_lines(path, skip_rows)
+    try:
+        return _layout(comments, content, delimiter, header)
+    except csv.Error as exc:  # e.g. a field over the csv module's limit (131,072 characters)
+        raise DataError(
+            f"{show(path)} cannot be split into fields near line {content[0][0]} ({exc}); "
+            "check that it is a delimited text file, or pass delimiter=."
+        ) from None
+
+
+def _layout(
+    comments: list[str], content: list[tuple[int, str]], delimiter: str | None, header: bool | None
+) -> TextFormat:
+    """The :class:`TextFormat` of the first comment and content lines of a file."""
     lines = [line for _, line in content]
     delim = _choose_delimiter(delimiter, lines)
     first = split_fields(lines[0], delim)

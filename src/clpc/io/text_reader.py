@@ -1,216 +1,220 @@
-"""Parsing the numbers of a text data file (CSV/TSV/whitespace), batch by batch.
+"""Reading the numbers of a text data file (CSV/TSV/whitespace) with ``pyarrow.csv``.
 
-Numbers are parsed in C by :func:`numpy.loadtxt` in batches of lines; only a batch that
-fails is re-read in Python to report the exact line, column and text.
+pyarrow parses the cells (delimiter, quotes, float64 conversion), block by block. Around it,
+this module keeps each row's file line and one number syntax for every reader:
+
+- :class:`~clpc.io.text_lines.DataLines` hands pyarrow the data lines without blank and
+  comment lines, and gives every row its line in the file.
+- Columns are read as float64. From the first block where pyarrow refuses a cell, or that
+  holds a NaN or inf, the rest of the file is read as text and every cell judged by the
+  number syntax of :func:`clpc.io.errors.parse_number`, so that a message names the line,
+  the column and the text of the first bad cell. An empty cell is refused unless
+  ``allow_missing``; a row with another number of fields than the header is refused.
 """
 
 from __future__ import annotations
 
-import math
-import operator
-import shutil
 import stat
-import tempfile
-import warnings
 from collections.abc import Iterator
-from itertools import islice, repeat
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from clpc.data import DataError
-from clpc.io.arrow_text import FallBack, arrow_batches, fast_path_applies
-from clpc.io.errors import cell_error, first_bad, parse_number, show
+from clpc.data.samples import NUMBER_TEXT
+from clpc.io.errors import cell_error, show
 from clpc.io.table import Chunks, Columns, reorder_columns, resolve_columns
-from clpc.io.text_format import (
-    READ_ERRORS,
-    TextFormat,
-    is_content,
-    open_text,
-    read_error,
-    sniff,
-    split_fields,
-)
+from clpc.io.text_format import READ_ERRORS, TextFormat, read_error, sniff
+from clpc.io.text_lines import BLOCK_BYTES, DataLines, copy_stream
 
-__all__ = ["TextReader", "text_source"]
+__all__ = ["rechunk", "text_source"]
+
+#: the number syntax of :func:`clpc.io.errors.parse_number`, for pyarrow's RE2
+_NUMBER_RE2 = f"^{NUMBER_TEXT.pattern}$"
 
 
-class TextReader:
-    """Parses batches of lines of one text file into float64 arrays.
-
-    Parameters
-    ----------
-    path : Path
-        The text file.
-    fmt : TextFormat
-        Its layout (from :func:`~clpc.io.text_format.sniff`).
-    use : list of int
-        The sorted unique 0-based columns to read.
-    allow_missing : bool
-        Keep empty cells and NaN/inf as NaN instead of raising.
-    fast : bool
-        Use pyarrow when it is installed (default); ``False``: the plain reader only (the
-        reference of the tests and benchmarks).
-    """
+class _Reader:
+    """The float64 values of the selected columns of one text file, with their lines."""
 
     def __init__(
-        self, path: Path, fmt: TextFormat, use: list[int], allow_missing: bool, fast: bool = True
+        self, path: Path, source: str, fmt: TextFormat, use: list[int], allow_missing: bool
     ):
-        self.fast = fast
-        self.path = path
-        self.source = show(path)
-        self.fmt = fmt
+        self.path, self.source, self.fmt = path, source, fmt
         self.use = use
-        self.full = use == list(range(fmt.n_cols))
         self.allow_missing = allow_missing
+        self.ragged: dict[bytes, int] = {}  # text -> fields of the ragged rows pyarrow met
+        self.whole = False  # the caller holds every value at once (read_table)
 
-    def batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """Values (n, len(use)) and 1-based line numbers (n,) of ``chunk_rows`` lines at a time.
+    def _open(self, as_text: bool) -> tuple[DataLines, Any]:
+        import pyarrow as pa
+        from pyarrow import csv
 
-        Through pyarrow when it is installed and the file is plain (:mod:`clpc.io.arrow_text`;
-        its blocks are re-cut into ``chunk_rows`` rows), else, and from the first block the
-        fast path cannot vouch for, by the plain reader.
-        """
+        names = [f"c{i}" for i in range(self.fmt.n_cols)]
+        wanted = [names[i] for i in self.use]
+        lines = DataLines(self.path, self.fmt)
+        delimiter = "\t" if self.fmt.delimiter is None else self.fmt.delimiter
+
+        def ragged(row: Any) -> str:
+            self.ragged[str(row.text).strip().encode()] = int(row.actual_columns)
+            return "error"
+
+        if not lines.peek():
+            return lines, iter(())  # no data lines (pyarrow: "Empty CSV file")
+        options = {
+            "read_options": csv.ReadOptions(column_names=names, block_size=BLOCK_BYTES),
+            "parse_options": csv.ParseOptions(
+                delimiter=delimiter, quote_char='"', invalid_row_handler=ragged
+            ),
+            "convert_options": csv.ConvertOptions(
+                include_columns=wanted,
+                column_types=dict.fromkeys(wanted, pa.string() if as_text else pa.float64()),
+                null_values=[""],
+                strings_can_be_null=True,
+            ),
+        }
+        if self.whole and not as_text:  # all at once: pyarrow parses the blocks in parallel
+            return lines, iter(csv.read_csv(lines, **options).to_batches())
+        return lines, csv.open_csv(lines, **options)
+
+    def batches(self) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Values ``(n, len(use))`` and the 1-based file line of each row, block by block."""
+        import pyarrow as pa
+
         done = 0
-        if self.fast and fast_path_applies(self.path, self.fmt):
+        try:
             try:
-                for values, rows in rechunk(
-                    arrow_batches(self.path, self.fmt, self.use, self.allow_missing), chunk_rows
-                ):
-                    yield values, rows
-                    done += values.shape[0]
-                return
-            except FallBack:
-                pass
-        for values, rows in self.plain_batches(chunk_rows):
-            if done >= values.shape[0]:
-                done -= values.shape[0]
-                continue
-            yield values[done:], rows[done:]
-            done = 0
-
-    def plain_batches(self, chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """As :meth:`batches`, always by the plain reader (``numpy.loadtxt`` and Python)."""
-        with open_text(self.path) as f:
-            try:
-                for _ in range(self.fmt.data_line - 1):
-                    next(f, None)
-                line_no = self.fmt.data_line
-                while True:
-                    lines = list(islice(f, chunk_rows))
-                    if not lines:
+                lines, reader = self._open(as_text=False)
+                with lines:
+                    for batch in reader:
+                        values, missing = _float_batch(batch)
+                        if not np.isfinite(values[~missing]).all():
+                            break  # a NaN or inf: its text decides
+                        where = lines.lines_of(done, batch.num_rows, self.fmt.data_line)
+                        if missing.any() and not self.allow_missing:
+                            row, col = np.argwhere(missing)[0]
+                            raise self._cell(where[row], col, "")
+                        yield values, where
+                        done += batch.num_rows
+                    else:
                         return
-                    data, rows = self.parse(lines, line_no)
-                    line_no += len(lines)
-                    if data.shape[0]:
-                        yield data, rows
-            except READ_ERRORS as exc:
-                raise read_error(self.path, exc) from None
+            except pa.ArrowInvalid:
+                if self.ragged:
+                    raise self._ragged_error() from None
+            yield from self._text_batches(done)
+        except READ_ERRORS as exc:
+            raise read_error(self.path, exc) from None
 
-    def parse(self, lines: list[str], first_no: int) -> tuple[np.ndarray, np.ndarray]:
-        """Values (n, len(use)) and 1-based line numbers (n,) of a batch of lines."""
-        arr = self._fast(lines)
-        rows: np.ndarray | None = None
-        if arr is not None:
-            if arr.shape[0] == len(lines):
-                rows = np.arange(first_no, first_no + len(lines), dtype=np.int64)
-            else:
-                idx = [i for i, line in enumerate(lines) if is_content(line)]
-                if len(idx) == arr.shape[0]:
-                    rows = first_no + np.asarray(idx, dtype=np.int64)
-        if arr is None or rows is None:
-            return self._slow(lines, first_no)
-        if not self.allow_missing:
-            bad = first_bad(arr)
-            if bad is not None:
-                row, col = bad
-                no = int(rows[row])
-                fields = split_fields(lines[no - first_no], self.fmt.delimiter, strip_comment=True)
-                c = self.use[col]
-                text = fields[c] if c < len(fields) else str(arr[row, col])
-                raise cell_error(f"line {no}", self.fmt.names[c], text, self.source)
-        return arr, rows
+    def _text_batches(self, start: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """As :meth:`batches` from data row ``start`` on, every cell judged by its text."""
+        import pyarrow as pa
 
-    def _fast(self, lines: list[str]) -> np.ndarray | None:
-        """numpy.loadtxt on the batch; None when anything looks unusual."""
-        fmt = self.fmt
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # "input contained no data"
-                if not self.full and not self._field_counts_ok(lines):
-                    return None
-                arr = np.loadtxt(
-                    lines,
-                    dtype=np.float64,
-                    delimiter=fmt.delimiter,
-                    comments="#",
-                    quotechar='"',
-                    ndmin=2,
-                    usecols=None if self.full else self.use,
-                )
-                n_cols = fmt.n_cols if self.full else len(self.use)
-                if arr.shape[0] == 0:
-                    return np.empty((0, n_cols))
-                if arr.shape[1] != n_cols:
-                    return None
-                return arr
-        except ValueError:
-            return None
+        done = 0
+        lines, reader = self._open(as_text=True)
+        with lines:
+            try:
+                for batch in reader:
+                    n = batch.num_rows
+                    if done + n > start:
+                        skip = max(start - done, 0)
+                        where = lines.lines_of(done + skip, n - skip, self.fmt.data_line)
+                        yield self._judge(batch.slice(skip), where), where
+                    done += n
+            except pa.ArrowInvalid as exc:
+                if self.ragged:
+                    raise self._ragged_error() from None
+                if "UTF8" in str(exc):
+                    raise DataError(
+                        f"{self.source} is not UTF-8 text (a cell holds other bytes); re-save "
+                        "it as UTF-8 CSV, or check that it is really a text file."
+                    ) from None
+                raise DataError(f"{self.source} cannot be read as a table: {exc}") from None
 
-    def _field_counts_ok(self, lines: list[str]) -> bool:
-        """Every content line has ``n_cols`` fields (a cheap check: no quotes or comments)."""
-        n = len(lines)
-        if self.fmt.delimiter is None:
-            counts = np.fromiter(map(len, map(str.split, lines)), dtype=np.int64, count=n)
-            expected = self.fmt.n_cols
-        else:
-            if any(map(operator.contains, lines, repeat('"'))):
-                return False
-            counts = np.fromiter(
-                map(str.count, lines, repeat(self.fmt.delimiter)), dtype=np.int64, count=n
+    def _judge(self, batch: Any, where: np.ndarray) -> np.ndarray:
+        """float64 values of a text batch; the first bad cell (row by row) raises."""
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        n, k = batch.num_rows, batch.num_columns
+        values = np.empty((n, k))
+        bad = np.zeros((n, k), dtype=bool)
+        for j in range(k):
+            text = pc.utf8_trim_whitespace(batch.column(j))
+            empty = pc.fill_null(pc.equal(text, ""), True)
+            number = pc.fill_null(
+                pc.match_substring_regex(text, _NUMBER_RE2, ignore_case=True), False
             )
-            expected = self.fmt.n_cols - 1
-        bad = np.flatnonzero(counts != expected)
-        return all(not is_content(lines[i]) for i in bad)
+            parsed = pc.cast(pc.if_else(number, text, pa.scalar(None, pa.string())), pa.float64())
+            col, _ = _float64(pc.fill_null(parsed, np.nan))
+            values[:, j] = col
+            ok = _float64(pc.cast(pc.or_(empty, number), pa.float64()))[0] > 0
+            missing = _float64(pc.cast(empty, pa.float64()))[0] > 0
+            bad[:, j] = ~ok if self.allow_missing else ~ok | missing | ~np.isfinite(col)
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            raise self._cell(where[row], col, batch.column(int(col))[int(row)].as_py() or "")
+        return values
 
-    def _slow(self, lines: list[str], first_no: int) -> tuple[np.ndarray, np.ndarray]:
-        """Python parsing of a batch: exact diagnostics (line, column, text)."""
+    def _cell(self, line: int, col: int, text: str) -> DataError:
+        return cell_error(f"line {int(line)}", self.fmt.names[self.use[col]], text, self.source)
+
+    def _ragged_error(self) -> DataError:
         fmt = self.fmt
-        values: list[list[float]] = []
-        rows: list[int] = []
-        for i, line in enumerate(lines):
-            if not is_content(line):
-                continue
-            no = first_no + i
-            fields = split_fields(line, fmt.delimiter, strip_comment=True)
-            if len(fields) != fmt.n_cols:
-                raise self._ragged(no, len(fields))
-            values.append([self._cell(fields[c], no, c) for c in self.use])
-            rows.append(no)
-        arr = np.array(values, dtype=np.float64).reshape(len(values), len(self.use))
-        return arr, np.asarray(rows, dtype=np.int64)
-
-    def _cell(self, text: str, no: int, c: int) -> float:
-        """The value of field ``text`` in column ``c`` of line ``no`` (empty: NaN)."""
-        try:
-            value = parse_number(text) if text else math.nan
-        except ValueError:
-            raise cell_error(f"line {no}", self.fmt.names[c], text, self.source) from None
-        if not self.allow_missing and not math.isfinite(value):
-            raise cell_error(f"line {no}", self.fmt.names[c], text, self.source)
-        return value
-
-    def _ragged(self, no: int, got: int) -> DataError:
-        fmt = self.fmt
+        line, got = self._first_ragged()
         if fmt.header_line is not None:
             ref = f"the header (line {fmt.header_line})"
         else:
             ref = f"the first data row (line {fmt.data_line})"
         return DataError(
-            f"{self.source} line {no} has {got} field(s) but {ref} has {fmt.n_cols} "
-            f"(delimiter {fmt.describe_delimiter()}); fix or remove that row, or pass "
-            "delimiter= if the separator was guessed wrongly."
+            f"{self.source} line {line} has {got} field(s) but {ref} has "
+            f"{fmt.n_cols} (delimiter {fmt.describe_delimiter()}); fix or remove that row, or "
+            "pass delimiter= if the separator was guessed wrongly."
         )
+
+    def _first_ragged(self) -> tuple[int | str, int]:
+        """Line and field count of the first ragged row (pyarrow's threads give its text)."""
+        row = 0
+        with DataLines(self.path, self.fmt) as lines:
+            for block in lines.blocks():
+                for line in block.split(b"\n")[:-1]:
+                    got = self.ragged.get(line.strip())
+                    if got is not None:
+                        return int(lines.lines_of(row, 1, self.fmt.data_line)[0]), got
+                    row += 1
+        return "?", next(iter(self.ragged.values()))
+
+
+def _float_batch(batch: Any) -> tuple[np.ndarray, np.ndarray]:
+    """float64 values ``(n, k)`` of a batch and where a cell is empty (a null)."""
+    n, k = batch.num_rows, batch.num_columns
+    values = np.empty((n, k))
+    missing = np.zeros((n, k), dtype=bool)
+    for j in range(k):
+        col, null = _float64(batch.column(j))
+        values[:, j] = col
+        if null is not None:
+            values[null, j] = np.nan
+            missing[:, j] = null
+    return values, missing
+
+
+def _float64(arr: Any) -> tuple[np.ndarray, np.ndarray | None]:
+    """A float64 pyarrow Array as numpy (a read-only view) and its null mask (None: no nulls).
+
+    Read from the Array's buffers: pyarrow's ``to_numpy`` imports pandas (about 0.2 s). The
+    values under a null are undefined.
+    """
+    if hasattr(arr, "combine_chunks"):
+        arr = arr.combine_chunks()
+    n, off = len(arr), arr.offset
+    validity, data = arr.buffers()[:2]
+    if n == 0 or data is None:
+        return np.zeros(n), None
+    values = np.frombuffer(data, dtype=np.float64, count=n, offset=8 * off)
+    if not arr.null_count or validity is None:
+        return values, None
+    bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
+    return values, ~bits[off : off + n].astype(bool)
 
 
 def text_source(
@@ -220,7 +224,7 @@ def text_source(
     header: bool | None,
     allow_missing: bool,
     skip_rows: int = 0,
-    fast: bool = True,
+    whole: bool = False,
 ) -> tuple[list[str], Chunks]:
     """Names of the selected columns of a text file and a chunk generator over them.
 
@@ -230,8 +234,9 @@ def text_source(
         An existing text data file.
     columns, delimiter, header, allow_missing, skip_rows
         As for :func:`clpc.io.read_table`.
-    fast : bool
-        Use pyarrow when installed (see :class:`TextReader`).
+    whole : bool
+        Every value will be held at once (:func:`clpc.io.read_table`): pyarrow parses the
+        whole file in parallel instead of block after block.
 
     Returns
     -------
@@ -242,33 +247,23 @@ def text_source(
     """
     spool, given = None, path
     if not stat.S_ISREG(path.stat().st_mode):
-        spool, path = _spool(path)
+        spool, path = copy_stream(path)
     fmt = sniff(path, delimiter, header, skip_rows)
     sel = resolve_columns(fmt.names, columns, show(given))
     use = sorted(set(sel))
-    reader = TextReader(path, fmt, use, allow_missing, fast)
-    reader.source = show(given)
-    batches = reader.batches
-    if spool is not None:
+    reader = _Reader(path, show(given), fmt, use, allow_missing)
+    reader.whole = whole
 
-        def batches(chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-            with spool:  # removed once read
-                yield from reader.batches(chunk_rows)
+    def batches(chunk_rows: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        # read_table joins pyarrow's blocks as they come; iter_table_chunks re-cuts them
+        blocks = reader.batches() if whole else rechunk(reader.batches(), chunk_rows)
+        if spool is None:
+            yield from blocks
+            return
+        with spool:  # removed once read
+            yield from blocks
 
     return [fmt.names[i] for i in sel], reorder_columns(batches, use, sel)
-
-
-def _spool(path: Path) -> tuple[tempfile.TemporaryDirectory[str], Path]:
-    """A named pipe or device copied to a temporary file, read once (nothing lost).
-
-    The layout is sniffed from the first lines and the data read from the start again:
-    a stream cannot be read twice, so it is copied to disk first (not into memory).
-    """
-    folder = tempfile.TemporaryDirectory(prefix="clpc-")
-    copy = Path(folder.name) / path.name
-    with open(path, "rb") as src, open(copy, "wb") as dst:
-        shutil.copyfileobj(src, dst, 1 << 20)
-    return folder, copy
 
 
 def rechunk(

@@ -9,6 +9,7 @@ from typing import Any
 
 from clpc.data import DataError
 from clpc.io.formats import file_kind
+from clpc.io.mat_files import write_mat
 from clpc.io.numpy_files import write_npy, write_npz
 from clpc.io.parquet import write_parquet
 from clpc.io.table import PathLike, named_columns
@@ -31,7 +32,8 @@ def write_table(
     path : str or os.PathLike
         ``.csv``/``.txt``/``.dat`` (comma), ``.tsv``/``.tab`` (tab), optionally ``.gz``;
         ``.parquet``/``.pq`` (needs pyarrow); ``.npy`` (the array only: names are not
-        stored, they read back as ``col0..``); ``.npz`` (one 1-D array per column).
+        stored, they read back as ``col0..``); ``.npz`` (one 1-D array per column); ``.mat``
+        (one column vector per column, named by a MATLAB name).
     names : sequence of str
         Column names, one per column.
     array : array_like, shape (n_rows, n_columns) or (n_rows,)
@@ -48,8 +50,6 @@ def write_table(
     ------
     DataError
         Unsupported extension, or names that do not match the columns.
-    ImportError
-        Parquet without pyarrow/pandas (``pip install 'clpc[frames]'``).
     """
     p = Path(os.fspath(path))
     kind = file_kind(p)
@@ -64,5 +64,7 @@ def write_table(
         write_parquet(p, listed, arr)
     elif kind == "npy":
         write_npy(p, arr)
+    elif kind == "mat":
+        write_mat(p, listed, arr)
     else:
         write_npz(p, listed, arr)
