@@ -23,7 +23,7 @@ def saved():
     rng = np.random.default_rng(31)
     u = rng.standard_normal(3000)
     y = clpc.simulate_arx(DEN, NUM, u) + 0.01 * rng.standard_normal(3000)
-    a = CLPC(3, 201, 12)
+    a = CLPC(order=2, window_size=201, cluster_size=12)
     a.push(u[:2000], y[:2000])
     return json.loads(json.dumps(a.state_dict())), u, y
 
@@ -70,7 +70,7 @@ def test_tampered_states_are_refused_with_the_field(saved, what, edit, match):
 
 def test_untampered_state_continues_identically(saved):
     state, u, y = saved
-    whole = CLPC(3, 201, 12).run(u, y)
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     resumed = CLPC.from_state_dict(copy.deepcopy(state)).push(u[2000:], y[2000:])
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
 
@@ -83,7 +83,7 @@ def test_state_saved_with_an_engine_setting_still_restores(saved):
     state["config"]["engine"] = "compiled"
     state["digest"] = digest(state)
     resumed = CLPC.from_state_dict(state).push(u[2000:], y[2000:])
-    whole = CLPC(3, 201, 12).run(u, y)
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
 
 
