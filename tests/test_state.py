@@ -87,6 +87,33 @@ def test_state_saved_with_an_engine_setting_still_restores(saved):
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
 
 
+def test_state_saved_with_the_former_names_is_mapped_once(saved):
+    # states saved before one name per setting: parameters_size (N + 1) and gate
+    from clpc.appraiser.state import digest
+
+    state, u, y = copy.deepcopy(saved[0]), saved[1], saved[2]
+    cfg = state["config"]
+    cfg["parameters_size"] = cfg.pop("order") + 1
+    cfg["gate"] = cfg.pop("guard")
+    state["digest"] = digest(state)
+    restored = CLPC.from_state_dict(state)
+    assert (restored.order, restored.guard) == (2, True)
+    assert "parameters_size" not in restored.state_dict()["config"]
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    resumed = restored.push(u[2000:], y[2000:])
+    np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
+
+
+def test_state_saved_with_the_ambiguous_sample_time_is_refused(saved):
+    from clpc.appraiser.state import digest
+
+    state = copy.deepcopy(saved[0])
+    state["config"]["sample_time"] = state["config"].pop("decimate_to") or 1.0
+    state["digest"] = digest(state)
+    with pytest.raises(StateError, match="ambiguous sample_time"):
+        CLPC.from_state_dict(state)
+
+
 @pytest.mark.parametrize(
     "text", ["[]", "3", '"x"', "{" * 100 + "}" * 100, '{"a": 1' + "0" * 500 + "}"]
 )

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser.decimation import Decimator, decimation_factor
-from clpc.appraiser.inputs import SCALAR_TYPES, as_columns, check_finite
+from clpc.appraiser.decimation import Decimator
+from clpc.appraiser.inputs import SCALAR_TYPES, as_chunk, as_columns, as_record, check_finite
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.state import AppraiserState
@@ -34,9 +34,7 @@ from clpc.appraiser.state_schema import (
 )
 from clpc.appraiser.state_schema import field as state_field
 from clpc.appraiser.trace import Trace
-from clpc.core.checks import check_positive
 from clpc.core.rules import RobustRule
-from clpc.data import DataError, IOData, as_iodata
 from clpc.data.samples import check_spread
 
 __all__ = ["CLPC"]
@@ -63,17 +61,13 @@ class CLPC:
     cluster_size : int
         ``C``: lag vectors between updates (the paper's ``data_cluster_dimension``; 12).
     dt : float, optional
-        Sample time of the data [s] given to :meth:`step`/:meth:`push`/:meth:`run` as plain
-        arrays (a record's own ``dt`` is used by :meth:`run`; the two must agree).
+        Sample time of plain arrays [s] (a record's own ``dt`` must agree).
     decimate_to : float, optional
-        Sample time [s] the appraiser works at, an integer multiple of the data's: the data
-        are low-pass filtered and decimated (Table 1: 0.01 on 1 ms data). Needs the data's
-        sample time (``dt``, or a record with ``dt``).
+        Sample time [s] worked at, an integer multiple of the data's: the data are low-pass
+        filtered and decimated (Table 1: 0.01 on 1 ms data). Needs the data's sample time.
     guard : bool
-        Accept an estimate only from a trusted window (default ``True``): one that holds
-        ``trust_rows`` lag vectors, whose output varies by at least three quantization steps,
-        and whose solution the data determine (:func:`clpc.core.rules.is_trusted`). ``False``
-        is the paper's appraiser: every computable estimate is accepted.
+        Accept estimates of trusted windows only (default ``True``; see ``docs/clpc.md`` and
+        :func:`clpc.core.rules.is_trusted`); ``False`` is the paper's appraiser.
     na, nb, nk : int, optional
         Separate orders and input delay (override ``order``).
     method, scaling, noise_ratio, noise_cov, rule
@@ -188,10 +182,7 @@ class CLPC:
     def step(self, u_k: Any, y_k: Any) -> Trace:
         """Feed one sample; returns the update it produced (a trace of 0 or 1 rows).
 
-        Parameters
-        ----------
-        u_k : float or array_like, shape (n_inputs,)
-        y_k : float or array_like, shape (n_outputs,)
+        ``u_k``: float or (n_inputs,); ``y_k``: float or (n_outputs,).
         """
         s = self._state
         rows_after = s.n_seen + 1 - s.max_lag
@@ -218,32 +209,18 @@ class CLPC:
     ) -> Trace:
         """Feed a chunk of samples of any length.
 
-        Parameters
-        ----------
-        u : array_like, shape (n,) or (n, n_inputs)
-        y : array_like, shape (n,) or (n, n_outputs)
-        progress : callable, optional
-            Called as ``progress(samples_done, samples_total, updates_done)`` after each
-            block of ``chunk_samples`` samples; the same is logged at ``DEBUG`` level on the
-            ``clpc.appraiser`` logger.
-
-        Returns
-        -------
-        Trace
-            The updates this chunk produced (possibly empty); the traces of consecutive
-            pushes concatenated equal :meth:`run` on the whole record.
+        ``u`` (n,) or (n, n_inputs), ``y`` (n,) or (n, n_outputs); ``progress(samples_done,
+        samples_total, updates_done)`` is called after each block of ``chunk_samples``
+        samples (also logged at ``DEBUG`` on the ``clpc.appraiser`` logger). Returns the
+        updates of this chunk (possibly none): consecutive pushes concatenated equal
+        :meth:`run` on the whole record.
         """
-        u2, y2, s = as_columns(u, "u"), as_columns(y, "y"), self._state
+        s = self._state
+        u2, y2 = as_chunk(u, y, s.n_seen)
         n = u2.shape[0]
-        if n != y2.shape[0]:
-            raise DataError(
-                f"u and y must have the same length; got len(u)={n}, len(y)={y2.shape[0]}."
-            )
-        check_finite(u2, "u", s.n_seen)
-        check_finite(y2, "y", s.n_seen)
         s.init_channels(u2.shape[1], y2.shape[1])
         if s.decimator is None:
-            s.set_decimator(Decimator(self._factor_for(None)))
+            s.set_decimator(Decimator(self.settings.factor(None)))
         decimator = s.decimator
         assert decimator is not None
         total = s.updates_after(n)
@@ -271,63 +248,22 @@ class CLPC:
     ) -> Trace:
         """Reset, then process a whole record (vectorised over windows).
 
-        Parameters
-        ----------
-        u : IOData or array_like, shape (T,) or (T, n_inputs)
-        y : array_like, shape (T,) or (T, n_outputs), optional
-        dt : float, optional
-            Sample time of the record [s] (default: the record's, else the constructor's).
-        progress : callable, optional
-            As for :meth:`push`.
-
-        Returns
-        -------
-        Trace
-            One row per update.
+        ``u`` an IOData or (T,) / (T, n_inputs), ``y`` (T,) / (T, n_outputs); ``dt`` the
+        record's sample time [s] (default: the record's, else the constructor's);
+        ``progress`` as for :meth:`push`. Returns one row per update.
         """
         s = self.reset()._state
-        if isinstance(u, np.ndarray) and isinstance(y, np.ndarray):
-            # plain arrays: validated by push, without IOData's defensive copy of the record
-            u_arr = as_columns(u, "u", allow_empty=False)
-            y_arr = as_columns(y, "y", allow_empty=False)
-            data_dt = None if dt is None else check_positive(dt, "dt", "s")
-            s.init_channels(u_arr.shape[1], y_arr.shape[1])
-        else:
-            data = as_iodata(u, y, dt)
-            if data.n_experiments > 1:
-                raise DataError(
-                    f"CLPC runs over one continuous record; this one holds "
-                    f"{data.n_experiments} experiments, and its windows would reach across "
-                    "their boundaries. Run each experiment on its own (IOData.split())."
-                )
-            u_arr, y_arr = data.u, data.y
-            data_dt = data.dt if isinstance(u, IOData) or dt is not None else None
-            names = (data.input_names, data.output_names)
-            s.init_channels(data.n_inputs, data.n_outputs, names)
-        own = self.dt
-        if data_dt is not None and own is not None and not math.isclose(data_dt, own, rel_tol=1e-9):
-            raise DataError(
-                f"the record's sample time is {data_dt:g} s but CLPC(dt={own:g}); they must "
-                "agree (dt is the data's sample time; decimate_to is the rate to work at)."
-            )
+        u_arr, y_arr, data_dt, names = as_record(u, y, dt)
+        s.init_channels(u_arr.shape[1], y_arr.shape[1], names)
+        factor = self.settings.factor(data_dt)
         if self.noise_cov is None and self.noise_ratio is None:
             check_spread(u_arr, y_arr, self.scaling)
-        decimator = Decimator(self._factor_for(data_dt))
-        s.set_decimator(decimator)
+        s.set_decimator(Decimator(factor))
         if self.decimate_to is None and data_dt is not None:
             s.record_dt = data_dt  # no decimation: the appraiser works at the data's rate
         trace = self.push(u_arr, y_arr, progress=progress)
-        attach_levels(trace, y_arr, decimator.factor)  # the windows' levels (steady state)
+        attach_levels(trace, y_arr, factor)  # the windows' levels (steady state)
         return trace
-
-    def _factor_for(self, data_dt: float | None) -> int:
-        dt = data_dt if data_dt is not None else self.dt
-        if dt is None and self.decimate_to is not None:
-            raise DataError(
-                f"decimate_to={self.decimate_to:g} s needs the data's sample time; pass dt= "
-                "to CLPC (or to run()), or give an IOData with its dt."
-            )
-        return decimation_factor(self.decimate_to, dt)
 
     def _threads(self, fn: Callable[..., Any], items: Iterable[Any]) -> Iterator[Any]:
         """``map`` on a thread pool kept for the appraiser's lifetime (made on first use)."""

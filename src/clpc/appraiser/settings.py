@@ -7,16 +7,19 @@ mapping the names of states saved before one name per setting once.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from dataclasses import field as dc_field
 from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.decimation import decimation_factor
 from clpc.appraiser.inputs import check_noise_cov
 from clpc.appraiser.state_schema import StateError
 from clpc.core.checks import check_bool, check_choice, check_int, check_positive
 from clpc.core.rules import SCALINGS, RobustRule
+from clpc.data import DataError
 from clpc.model.structure import Structure
 
 __all__ = ["Settings"]
@@ -96,6 +99,22 @@ class Settings:
                 f"parameters need (min_rows, default 2 p): every update would be 'not enough "
                 f"data'. Use window_size >= {need} or fewer parameters."
             )
+
+    def factor(self, data_dt: float | None) -> int:
+        """The decimation factor for data sampled every ``data_dt`` [s] (``None``: ``dt``)."""
+        own = self.dt
+        if data_dt is not None and own is not None and not math.isclose(data_dt, own, rel_tol=1e-9):
+            raise DataError(
+                f"the record's sample time is {data_dt:g} s but CLPC(dt={own:g}); they must "
+                "agree (dt is the data's sample time; decimate_to is the rate to work at)."
+            )
+        rate = data_dt if data_dt is not None else own
+        if rate is None and self.decimate_to is not None:
+            raise DataError(
+                f"decimate_to={self.decimate_to:g} s needs the data's sample time; pass dt= "
+                "to CLPC (or to run()), or give an IOData with its dt."
+            )
+        return decimation_factor(self.decimate_to, rate)
 
     def config(self) -> dict[str, Any]:
         """The constructor arguments (JSON-safe)."""
