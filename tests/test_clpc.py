@@ -83,9 +83,8 @@ def test_outputs_hold_between_updates():
 
 def test_not_enough_data_is_flagged_and_not_used():
     u, y = record(300)
-    trace = CLPC(order=2, window_size=201, cluster_size=4, guard=False).run(
-        u, y
-    )  # the paper's appraiser: no guard
+    # the paper's appraiser: no guard
+    trace = CLPC(order=2, window_size=201, cluster_size=4, guard=False).run(u, y)
     p = 6
     assert np.all(trace.not_enough_data == (trace.rows < 2 * p))
     first_ok = np.flatnonzero(~trace.not_enough_data)[0]
@@ -504,9 +503,8 @@ def test_default_guard_never_holds_an_untrusted_model_on_real_records(name):
 
 
 def test_convergence_of_a_trace_without_updates():
-    trace = CLPC(order=2, window_size=201, cluster_size=12).run(
-        np.arange(10.0), np.arange(10.0)
-    )  # 8 lag rows: no update
+    # 8 lag rows: no update
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(np.arange(10.0), np.arange(10.0))
     assert len(trace) == 0
     conv = trace.convergence()
     assert not conv.converged and conv.reason
@@ -525,8 +523,7 @@ def test_windows_that_can_never_hold_a_model_are_refused_up_front():
         CLPC(window_size=3)
     with pytest.raises(ValueError, match="1000 parameters need"):
         CLPC(order=499)
-    miso = CLPC(
-        order=2, window_size=13, cluster_size=1, mimo="miso"
-    )  # 12 parameters with 3 inputs: known at the data
+    # 12 parameters with 3 inputs: known at the data
+    miso = CLPC(order=2, window_size=13, cluster_size=1, mimo="miso")
     with pytest.raises(ValueError, match="window_size=13 cannot hold the 24"):
         miso.run(np.ones((100, 3)), np.ones(100))

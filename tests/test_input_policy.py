@@ -109,9 +109,8 @@ def test_extreme_scales_are_refused_by_both_estimators_without_warnings(
 def test_scales_within_the_limits_still_work_and_std_scaling_lifts_the_spread(uy):
     u, y = uy
     ref = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
-    same = CLPC(order=2, window_size=201, cluster_size=12).run(
-        u * 1e-60, y * 1e-60
-    )  # homogeneous: theta unchanged
+    # homogeneous: theta unchanged
+    same = CLPC(order=2, window_size=201, cluster_size=12).run(u * 1e-60, y * 1e-60)
     np.testing.assert_allclose(same.theta, ref.theta, rtol=1e-6, atol=1e-9)
     assert same.accepted.sum() == ref.accepted.sum()
     factor = 10 * MAX_SPREAD
