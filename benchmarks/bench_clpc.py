@@ -3,7 +3,7 @@
 Data: a white Gaussian input (persistently exciting of any order) through the 2nd-order ARX
 system ``A(q) y = B(q) u + e`` with ``A = 1 - 1.5 q^-1 + 0.7 q^-2``, ``B = 0.5 + 0.3 q^-1 +
 0.1 q^-2`` and equation noise ``e ~ N(0, 0.1^2)``, plus white measurement noise (std 0.02) on
-``y``. Settings: ``N = 2`` (``parameters_size = 3``), ``W = 201``, ``C = 12``.
+``y``. Settings: ``order = N = 2`` (the paper's ``parameters_size = 3``), ``W = 201``, ``C = 12``.
 
 Engines: every rule has one source (:mod:`clpc.core.rules`, kernel
 :mod:`clpc.appraiser.kernel`), run compiled by numba (``compiled``, the default) or
@@ -234,7 +234,7 @@ def _execute(spec: dict, u, y) -> dict:
 
     kind = spec["kind"]
     kw = dict(
-        parameters_size=ORDER + 1,
+        order=ORDER,
         window_size=WINDOW,
         cluster_size=spec.get("cluster", CLUSTER),
         method=spec.get("method", "robust"),
@@ -280,7 +280,9 @@ def worker(spec: dict) -> dict:
     wu = min(n, 5000)
     _execute(spec, u[:wu], y[:wu])
     u_w, y_w = np.asarray(u[:wu], dtype=np.float64), np.asarray(y[:wu], dtype=np.float64)
-    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, n_jobs=spec.get("n_jobs", 1)).run(u_w, y_w)
+    clpc.CLPC(
+        order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, n_jobs=spec.get("n_jobs", 1)
+    ).run(u_w, y_w)
     can_reset = _reset_peak()
     base = _status_mb().get("VmRSS", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
     base_peak = _peak_rss_mb(can_reset)
@@ -335,7 +337,7 @@ def huge_worker(spec: dict) -> dict:
     raw = getattr(data, "_mmap", None)
     offset = data.offset if hasattr(data, "offset") else 0
     n = data.shape[0]
-    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER)
+    app = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER)
     app.push(data[:5000, 0], data[:5000, 1])  # warm-up (not timed)
     app.reset()
     can_reset = _reset_peak()
@@ -405,14 +407,14 @@ def profile(workdir: Path, n: int, n_step: int, top: int = 18) -> None:
 
     u, y = load(workdir, n)
     u_s, y_s = u[:n_step].tolist(), y[:n_step].tolist()
-    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER)
+    app = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER)
     app.run(u[:5000], y[:5000])  # warm-up (compiles the kernel if numba's cache is cold)
     _steps(u_s[:2000], y_s[:2000])
     name = _engine_here()
     for title, stmt in (
         (
             f"CLPC({name}).run, T={fmt_n(n)}",
-            lambda: clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).run(u, y),
+            lambda: clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER).run(u, y),
         ),
         (f"step x {fmt_n(n_step)} (Python floats, {name})", lambda: _steps(u_s, y_s)),
     ):
@@ -432,7 +434,7 @@ def profile(workdir: Path, n: int, n_step: int, top: int = 18) -> None:
 def _steps(u: list[float], y: list[float]) -> None:
     import clpc
 
-    step = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).step
+    step = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER).step
     for u_k, y_k in zip(u, y, strict=True):
         step(u_k, y_k)
 
@@ -496,9 +498,9 @@ def prime_worker(spec: dict) -> dict:
     u, y = load(Path(spec["workdir"]), 3000)
     t0 = time.perf_counter()
     kw = {"method": spec.get("method", "robust")}
-    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw).run(u, y)
-    clpc.CLPC(ORDER + 1, WINDOW, 1, **kw).run(u, y)
-    app = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, **kw)
+    clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, **kw).run(u, y)
+    clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=1, **kw).run(u, y)
+    app = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, **kw)
     app.push(u[:1000], y[:1000])
     for u_k, y_k in zip(u[1000:].tolist(), y[1000:].tolist(), strict=True):
         app.step(u_k, y_k)
@@ -517,7 +519,9 @@ def dump_worker(spec: dict) -> dict:
     u, y = load(Path(spec["workdir"]), spec["n"])
     arrays = {}
     for method in ("robust", "paper"):
-        tr = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method).run(u, y)
+        tr = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, method=method).run(
+            u, y
+        )
         for key in ("theta", "theta_estimate", "D", "accepted"):
             arrays[f"{method}_{key}"] = np.asarray(getattr(tr, key))
     np.savez(spec["out"], **arrays)
@@ -716,7 +720,7 @@ def main(argv: list[str] | None = None) -> int:
     # no worker ever compiles (each also warms up before timing)
     u0, y0 = load(workdir, 5000)
     c0 = time.perf_counter()
-    clpc.CLPC(ORDER + 1, WINDOW, CLUSTER).run(u0, y0)
+    clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER).run(u0, y0)
     c_here = time.perf_counter() - c0
     prime = {"workdir": str(workdir), "engine": "compiled"}
     c_new = run_worker(prime, flag="--prime-worker")["time"]
@@ -1080,7 +1084,7 @@ def main(argv: list[str] | None = None) -> int:
     for eng in engines:
 
         def make(method: str = "robust", eng: str = eng) -> clpc.CLPC:
-            return clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method)
+            return clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, method=method)
 
         tr = paper[eng] = make("paper").run(u, y)
         assert len(tr) == th_ref.shape[0], (len(tr), th_ref.shape)
@@ -1148,7 +1152,9 @@ def main(argv: list[str] | None = None) -> int:
             slow = {k: z[k] for k in z.files}
         for method in ("robust", "paper"):
             a = {k[len(method) + 1 :]: v for k, v in slow.items() if k.startswith(method + "_")}
-            b = clpc.CLPC(ORDER + 1, WINDOW, CLUSTER, method=method).run(u[:n_py], y[:n_py])
+            b = clpc.CLPC(order=ORDER, window_size=WINDOW, cluster_size=CLUSTER, method=method).run(
+                u[:n_py], y[:n_py]
+            )
             print(
                 f"- python (NUMBA_DISABLE_JIT=1) vs compiled ({method} batch, "
                 f"T={fmt_n(n_py)}): {agreement(a, arrays(b))}"

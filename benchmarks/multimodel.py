@@ -66,7 +66,7 @@ def crank(seeds=range(5)) -> None:
                 ),
             ]
             u, y = ident.command, ident.position
-            trace = clpc.CLPC(3, 201, 12).run(u, y, dt=0.01)
+            trace = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(u, y, dt=0.01)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 steady = trace.steady_state_model(allow_unconverged=True)
@@ -118,7 +118,7 @@ def what_d_measures() -> None:
     print("\n3. what D measures (crank servo, seed 0, Table 1 windows)")
     ident = simulate_crank_servo(crank_commands(60, seed=0), seed=1)
     u, y = ident.command, ident.position
-    trace = clpc.CLPC(3, 201, 12).run(u, y, dt=0.01)
+    trace = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(u, y, dt=0.01)
     rep = operating_point_diagnostics(trace, u, y)
     ok = np.isfinite(rep.mismatch)
     var = (

@@ -232,7 +232,9 @@ def test_track_writes_trace_figures_report(record, tmp_path):
     for name in ("trace.csv", "trace.png", "pz.png", "bode.png", "report.html"):
         assert (out_dir / name).stat().st_size > 0, name
     assert "updates:" in res.output and "wrote" in res.output
-    ref = clpc.CLPC(3, 101, 10, sample_time=dt, nk=1, guard=False).run(u, y, dt)
+    ref = clpc.CLPC(order=2, window_size=101, cluster_size=10, dt=dt, nk=1, guard=False).run(
+        u, y, dt
+    )
     table = read_table(out_dir / "trace.csv")
     np.testing.assert_array_equal(table["index"], ref.index)
     np.testing.assert_allclose(table["time"], ref.time, rtol=1e-12)
@@ -319,7 +321,9 @@ def test_stream_in_process_skips_malformed_lines(record):
     text, bad_lines = _stream_lines(u, y, BAD)
     res = ok("stream", "--window-size", "51", "--cluster-size", "7", input=text)
     got = [json.loads(line) for line in res.stdout.splitlines()]
-    _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    _assert_same_updates(
+        got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y))
+    )
     for no in bad_lines:
         assert f"line {no}:" in res.stderr
     assert f"{len(bad_lines)} malformed line(s) skipped" in res.stderr
@@ -333,7 +337,9 @@ def test_stream_stop_on_error(record):
     )
     assert f"line {bad_lines[0]}: field 2 'x' is not a number" in res.stderr
     # the updates before the bad line were written
-    assert len(res.stdout.splitlines()) == len(clpc.CLPC(3, 20, 5).run(u[:60], y[:60]))
+    assert len(res.stdout.splitlines()) == len(
+        clpc.CLPC(order=2, window_size=20, cluster_size=5).run(u[:60], y[:60])
+    )
 
 
 def test_stream_jsonl_mimo_and_sample_time(rng):
@@ -364,7 +370,9 @@ def test_stream_jsonl_mimo_and_sample_time(rng):
         input=text,
     )
     got = [json.loads(line) for line in res.stdout.splitlines()]
-    want = update_records(clpc.CLPC(3, 40, 10, sample_time=0.5, nk=1).run(u, y, 0.5))
+    want = update_records(
+        clpc.CLPC(order=2, window_size=40, cluster_size=10, dt=0.5, nk=1).run(u, y, 0.5)
+    )
     _assert_same_updates(got, want)
     assert got[0]["time"] == pytest.approx(0.5 * got[0]["index"])
     assert "line 201: 'y' must be a list of 2 numbers" in res.stderr
@@ -397,7 +405,9 @@ def test_stream_through_a_real_pipe(record):
     assert len(early.splitlines()) == 3  # the updates of the first lines, before EOF
     assert proc.returncode == 0, err
     got = [json.loads(line) for line in out.splitlines()]
-    _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    _assert_same_updates(
+        got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y))
+    )
     for no in bad_lines:
         assert f"line {no}:" in err
     assert "Traceback" not in err
@@ -549,7 +559,10 @@ def test_stream_samples_matches_a_batch_run(record):
     settings = wf.StreamSettings(wf.AppraiserSettings(window_size=40, cluster_size=9))
     batches = list(wf.stream_samples([lines[:50], lines[50:]], settings))
     records = [r for b in batches for r in b.records]
-    _assert_same_updates(records, update_records(clpc.CLPC(3, 40, 9).run(u[:200], y[:200])))
+    _assert_same_updates(
+        records,
+        update_records(clpc.CLPC(order=2, window_size=40, cluster_size=9).run(u[:200], y[:200])),
+    )
     assert [m.split(":")[0] for b in batches for m in b.skipped] == [f"line {bad_lines[0]}"]
     stop = dataclasses.replace(settings, on_error="stop")
     with pytest.raises(clpc.DataError, match="field 2 'x' is not a number"):
@@ -592,6 +605,8 @@ def test_stream_jsonl_survives_huge_numbers_and_deep_nesting(record):
         input="\n".join(lines),
     )
     got = [json.loads(line) for line in res.stdout.splitlines()]
-    _assert_same_updates(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    _assert_same_updates(
+        got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y))
+    )
     assert "line 51: 'u' holds a number too large for a float" in res.stderr
     assert "line 121: not a sample: JSON nested too deeply" in res.stderr

@@ -169,7 +169,7 @@ def test_stream_skips_every_malformed_line_and_keeps_the_rest(sig, fmt, bad):
         input="\n".join(lines) + "\n",
     )
     got = [json.loads(x) for x in res.stdout.splitlines()]
-    _same(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    _same(got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y)))
     for no in bad_numbers:
         assert f"line {no}:" in res.stderr, (no, res.stderr[-2000:])
     assert f"{len(bad)} malformed line(s) skipped" in res.stderr
@@ -190,7 +190,7 @@ def test_stream_first_line_that_is_not_data_is_reported(sig):
         )
         assert "line 1:" in res.stderr, res.stderr
         got = [json.loads(x) for x in res.stdout.splitlines()]
-        _same(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+        _same(got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y)))
     res = code(
         0, "stream", "--window-size", "51", "--cluster-size", "7", input="u,y\n" + _csv(u, y)
     )
@@ -204,7 +204,12 @@ def test_stream_header_with_a_data_like_name_is_not_swallowed(sig):
         0, "stream", "--window-size", "51", "--cluster-size", "7", input="1e3,2\n" + _csv(u, y)
     )
     got = [json.loads(x) for x in res.stdout.splitlines()]
-    _same(got, update_records(clpc.CLPC(3, 51, 7).run(np.r_[1e3, u], np.r_[2, y])))
+    _same(
+        got,
+        update_records(
+            clpc.CLPC(order=2, window_size=51, cluster_size=7).run(np.r_[1e3, u], np.r_[2, y])
+        ),
+    )
     assert "header" not in res.stderr
 
 
@@ -214,7 +219,7 @@ def test_stream_selects_columns_by_name_and_index(sig):
     rows = "".join(
         f"{k},{float(b)!r},9,{float(a)!r}\n" for k, (a, b) in enumerate(zip(u, y, strict=True))
     )
-    want = update_records(clpc.CLPC(3, 51, 7).run(u, y, 0.5))
+    want = update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y, 0.5))
     text = "t,pos,junk,volt\n" + "".join(
         f"{0.5 * k!r},{float(b)!r},9,{float(a)!r}\n"
         for k, (a, b) in enumerate(zip(u, y, strict=True))
@@ -243,7 +248,7 @@ def test_stream_selects_columns_by_name_and_index(sig):
     )
     _same(
         [json.loads(x) for x in res.stdout.splitlines()],
-        update_records(clpc.CLPC(3, 51, 7).run(u, y)),
+        update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y)),
     )
     res = code(2, "stream", "-u", "nope", "-y", "pos", input=text)
     assert "nope" in res.output
@@ -267,7 +272,7 @@ def test_stream_selects_columns_by_name_and_index(sig):
     )
     _same(
         [json.loads(x) for x in res.stdout.splitlines()],
-        update_records(clpc.CLPC(3, 51, 7).run(u, y)),
+        update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y)),
     )
 
 
@@ -308,7 +313,7 @@ def test_stream_reads_a_named_pipe_without_loss(tmp_path, sig):
     t.join()
     assert proc.returncode == 0, proc.stderr
     got = [json.loads(x) for x in proc.stdout.splitlines()]
-    _same(got, update_records(clpc.CLPC(3, 51, 7).run(u, y)))
+    _same(got, update_records(clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u, y)))
 
 
 # ------------------------------------------------------------------ simulate / compare

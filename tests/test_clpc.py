@@ -48,7 +48,7 @@ def exact_window(u, y, end_row, window, order=2):
 @pytest.mark.parametrize(("window", "cluster"), [(201, 12), (30, 7), (24, 12), (12, 1)])
 def test_updates_every_cluster_growing_then_sliding(window, cluster):
     u, y = record(600)
-    trace = CLPC(3, window, cluster).run(u, y)
+    trace = CLPC(order=2, window_size=window, cluster_size=cluster).run(u, y)
     max_lag = 2
     j = np.arange(1, (600 - max_lag) // cluster + 1)
     assert len(trace) == j.size
@@ -60,17 +60,20 @@ def test_updates_every_cluster_growing_then_sliding(window, cluster):
 
 def test_paper_names_and_time():
     u, y = record(500)
-    a = CLPC(parameters_size=3, window_size=201, data_cluster_dimension=12, sample_time=0.01)
+    a = CLPC(order=2, window_size=201, cluster_size=12, dt=0.01)
     trace = a.run(u, y)
     assert a.cluster_size == 12
     np.testing.assert_allclose(trace.time, trace.index * 0.01)
-    with pytest.raises(ValueError, match="same setting"):
-        CLPC(3, 201, cluster_size=12, data_cluster_dimension=10)
+    for old in ("parameters_size", "data_cluster_dimension", "sample_time", "gate"):
+        with pytest.raises(TypeError, match=old):
+            CLPC(**{old: 3})  # the paper's and former names are not settings
+    with pytest.raises(TypeError):
+        CLPC(3, 201, 12)  # type: ignore[misc]  # settings are named
 
 
 def test_outputs_hold_between_updates():
     u, y = record(400, noise=0.05)
-    trace = CLPC(3, 50, 12).run(u, y)
+    trace = CLPC(order=2, window_size=50, cluster_size=12).run(u, y)
     held = trace.held(400)
     for k in (0, 13, 14, 25, 26, 100, 399):
         last = np.flatnonzero(trace.index <= k)
@@ -80,20 +83,21 @@ def test_outputs_hold_between_updates():
 
 def test_not_enough_data_is_flagged_and_not_used():
     u, y = record(300)
-    trace = CLPC(3, 201, 4, guard=False).run(u, y)  # the paper's appraiser: no guard
+    # the paper's appraiser: no guard
+    trace = CLPC(order=2, window_size=201, cluster_size=4, guard=False).run(u, y)
     p = 6
     assert np.all(trace.not_enough_data == (trace.rows < 2 * p))
     first_ok = np.flatnonzero(~trace.not_enough_data)[0]
     assert not trace.has_model[:first_ok].any()
     assert np.all(trace.theta[:first_ok] == 0)
     assert trace.has_model[first_ok]
-    trace2 = CLPC(3, 201, 4, min_rows=40).run(u, y)
+    trace2 = CLPC(order=2, window_size=201, cluster_size=4, min_rows=40).run(u, y)
     assert np.all(trace2.not_enough_data == (trace2.rows < 40))
 
 
 def test_noise_free_recovery_and_steady_state():
     u, y = record(3000)
-    trace = CLPC(3, 201, 12, sample_time=0.01).run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12, dt=0.01).run(u, y)
     ok = trace.accepted
     np.testing.assert_allclose(trace.den[ok], np.broadcast_to(DEN, (ok.sum(), 3)), atol=1e-9)
     np.testing.assert_allclose(trace.num[ok][:, 0], np.broadcast_to(NUM, (ok.sum(), 3)), atol=1e-9)
@@ -110,7 +114,7 @@ def test_unconverged_steady_state_raises():
     rng = np.random.default_rng(3)
     u = rng.standard_normal(800)
     y = rng.standard_normal(800)  # no relation at all: parameters wander
-    trace = CLPC(3, 30, 6, guard=False).run(u, y)
+    trace = CLPC(order=2, window_size=30, cluster_size=6, guard=False).run(u, y)
     conv = trace.convergence(theta_tol=1e-6, D_tol=1e-6)
     assert not conv.converged
     with pytest.raises(ValueError, match="never became quasi-constant"):
@@ -126,8 +130,8 @@ def test_unconverged_steady_state_raises():
 @given(st.lists(st.integers(min_value=1, max_value=300), min_size=1, max_size=40))
 def test_push_any_chunking_equals_run(chunks):
     u, y = record(2500, seed=1, noise=0.01)
-    batch = CLPC(3, 201, 12).run(u, y)
-    a = CLPC(3, 201, 12)
+    batch = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    a = CLPC(order=2, window_size=201, cluster_size=12)
     parts, i = [], 0
     sizes = itertools.cycle(chunks)
     while i < u.size:
@@ -148,8 +152,8 @@ def test_push_any_chunking_equals_run(chunks):
 
 def test_step_equals_run_and_exposes_state():
     u, y = record(700, seed=2, noise=0.01)
-    batch = CLPC(3, 60, 12).run(u, y)
-    a = CLPC(3, 60, 12)
+    batch = CLPC(order=2, window_size=60, cluster_size=12).run(u, y)
+    a = CLPC(order=2, window_size=60, cluster_size=12)
     parts = [a.step(u[k], y[k]) for k in range(700)]
     streamed = Trace.concat(parts)
     np.testing.assert_allclose(streamed.theta, batch.theta, rtol=0, atol=1e-12)
@@ -162,8 +166,8 @@ def test_step_equals_run_and_exposes_state():
 
 def test_save_restore_mid_record_continues_identically(tmp_path):
     u, y = record(1500, seed=4, noise=0.02)
-    full = CLPC(3, 101, 12, sample_time=0.01).run(u, y)
-    a = CLPC(3, 101, 12, sample_time=0.01)
+    full = CLPC(order=2, window_size=101, cluster_size=12, dt=0.01).run(u, y)
+    a = CLPC(order=2, window_size=101, cluster_size=12, dt=0.01)
     first = a.push(u[:777], y[:777])
     state = json.loads(json.dumps(a.state_dict()))
     b = CLPC.from_state_dict(state)
@@ -181,7 +185,7 @@ def test_save_restore_mid_record_continues_identically(tmp_path):
 # ---------------------------------------------------------------- exactness
 def test_fast_path_equals_exact_recomputation_with_offsets():
     u, y = record(4000, seed=5, noise=0.05, offset=1e4)
-    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12, method="paper").run(u, y)
     for t in range(0, len(trace), 7):
         end_row = (t + 1) * 12
         _scatter, vals, vecs = exact_window(u, y, end_row, 201)
@@ -197,7 +201,7 @@ def test_no_drift_over_a_million_samples():
     n = 1_000_000
     u = rng.standard_normal(n) + 1e4
     y = clpc.simulate_arx(DEN, NUM, u - 1e4) + 0.05 * rng.standard_normal(n) + 1e4
-    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12, method="paper").run(u, y)
     for t in (len(trace) - 1, len(trace) // 2, len(trace) - 1000):
         _scatter, vals, vecs = exact_window(u, y, (t + 1) * 12, 201)
         np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
@@ -217,7 +221,7 @@ def test_tracks_a_parameter_jump_within_one_window():
     y = np.concatenate([y1, np.zeros(2000)])
     for n in range(2000, 4000):
         y[n] = -den2[1] * y[n - 1] - den2[2] * y[n - 2] + num2 @ u[n - np.arange(3)]
-    trace = CLPC(3, 201, 12).run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     after = trace.index >= 2000 + 201 + 12
     np.testing.assert_allclose(trace.den[after], np.broadcast_to(den2, (after.sum(), 3)), atol=1e-8)
     before = (trace.index < 2000) & trace.accepted
@@ -239,7 +243,7 @@ def test_degenerate_windows_are_flagged_not_crashed(kind):
     else:
         u[400:800] = np.repeat(rng.standard_normal(100), 4)
         y[400:800] = np.repeat(rng.standard_normal(100), 4)
-    trace = CLPC(3, 100, 12).run(u, y)
+    trace = CLPC(order=2, window_size=100, cluster_size=12).run(u, y)
     for key in ("theta", "den", "num", "D", "eigenvalues", "J", "c", "noise_variance"):
         assert np.all(np.isfinite(trace.arrays[key])), key
     if kind == "zeros":
@@ -263,7 +267,7 @@ def test_gate_holds_parameters_when_excitation_is_lost():
     rng = np.random.default_rng(9)
     u = np.concatenate([rng.standard_normal(1000), np.linspace(0, 5, 500), np.full(1500, 5.0)])
     y = clpc.simulate_arx(DEN, NUM, u) + 1e-3 * rng.standard_normal(n)
-    gated = CLPC(3, 201, 12, gate=True).run(u, y)
+    gated = CLPC(order=2, window_size=201, cluster_size=12, guard=True).run(u, y)
     flat = gated.index > 1500 + 201 + 12
     assert not gated.accepted[flat].any()
     good = gated.accepted & (gated.index < 1000)
@@ -280,13 +284,13 @@ def test_mimo_paired_and_miso():
             clpc.simulate_arx([1, -0.5, 0.1], [1, 0.2, 0], u[:, 1]),
         ]
     )
-    paired = CLPC(3, 201, 12, mimo="paired").run(u, y)
+    paired = CLPC(order=2, window_size=201, cluster_size=12, mimo="paired").run(u, y)
     assert paired.theta.shape == (len(paired), 2, 6)
     np.testing.assert_allclose(paired.den[-1], [DEN, [1, -0.5, 0.1]], atol=1e-9)
     np.testing.assert_allclose(paired.num[-1, 0, 0], NUM, atol=1e-9)
     np.testing.assert_allclose(paired.num[-1, 0, 1], 0.0)
     y2 = y[:, 0] + clpc.simulate_arx(DEN, [0.3, 0, 0], u[:, 1])
-    miso = CLPC(3, 201, 12, mimo="miso").run(u, y2)
+    miso = CLPC(order=2, window_size=201, cluster_size=12, mimo="miso").run(u, y2)
     assert miso.theta.shape == (len(miso), 9)
     np.testing.assert_allclose(miso.den[-1], DEN, atol=1e-9)
     np.testing.assert_allclose(miso.num[-1], [NUM, [0.3, 0, 0]], atol=1e-9)
@@ -297,37 +301,41 @@ def test_decimation_by_sample_time():
     u_fast = np.repeat(rng.standard_normal(800), 10) + 0.01 * rng.standard_normal(8000)
     y_fast = signal.lfilter([0.05], [1, -0.95], u_fast)
     data = clpc.IOData(u_fast, y_fast, dt=0.001)
-    trace = CLPC(3, 101, 12, sample_time=0.01).run(data)
+    trace = CLPC(order=2, window_size=101, cluster_size=12, decimate_to=0.01).run(data)
     # reference: the same causal filter started at rest at the first sample, every 10th
     sos = signal.butter(4, 0.08, output="sos")
     x = np.column_stack([u_fast, y_fast])
     zi = signal.sosfilt_zi(sos)[:, :, None] * x[0][None, None, :]
     filt, _ = signal.sosfilt(sos, x, axis=0, zi=zi)
-    ref = CLPC(3, 101, 12, sample_time=0.01).run(filt[::10, 0], filt[::10, 1])
+    ref = CLPC(order=2, window_size=101, cluster_size=12).run(filt[::10, 0], filt[::10, 1], 0.01)
     np.testing.assert_allclose(trace.theta, ref.theta, atol=1e-12)
     np.testing.assert_array_equal(trace.index, ref.index)
     # streaming with the data's sample time gives the same
-    a = CLPC(3, 101, 12, sample_time=0.01, data_sample_time=0.001)
+    a = CLPC(order=2, window_size=101, cluster_size=12, decimate_to=0.01, dt=0.001)
     streamed = Trace.concat(
         [a.push(u_fast[i : i + 333], y_fast[i : i + 333]) for i in range(0, 8000, 333)]
     )
     np.testing.assert_allclose(streamed.theta, trace.theta, atol=1e-12)
     with pytest.raises(DataError, match="integer multiple"):
-        CLPC(3, 101, 12, sample_time=0.015).run(clpc.IOData(u_fast, y_fast, dt=0.01))
+        CLPC(order=2, window_size=101, cluster_size=12, decimate_to=0.015).run(
+            clpc.IOData(u_fast, y_fast, dt=0.01)
+        )
     with pytest.raises(DataError, match="integer multiple"):
-        CLPC(3, 101, 12, sample_time=0.01).run(clpc.IOData(u_fast, y_fast, dt=0.02))
+        CLPC(order=2, window_size=101, cluster_size=12, decimate_to=0.01).run(
+            clpc.IOData(u_fast, y_fast, dt=0.02)
+        )
 
 
 def test_threads_give_the_same_result():
     u, y = record(20000, seed=12, noise=0.01)
-    one = CLPC(3, 201, 12).run(u, y)
-    two = CLPC(3, 201, 12, n_jobs=2).run(u, y)
+    one = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    two = CLPC(order=2, window_size=201, cluster_size=12, n_jobs=2).run(u, y)
     np.testing.assert_array_equal(one.theta, two.theta)
 
 
 def test_to_frame_columns():
     u, y = record(500, noise=0.01)
-    frame = CLPC(3, 101, 12).run(u, y).to_frame()
+    frame = CLPC(order=2, window_size=101, cluster_size=12).run(u, y).to_frame()
     for col in ("index", "time", "rows", "a0", "a1", "a2", "b0", "b1", "b2", "D", "accepted"):
         assert col in frame.columns
 
@@ -336,11 +344,11 @@ def test_to_frame_columns():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"parameters_size": 1}, "parameters_size must be an int"),
+        ({"order": 0}, "order must be an int"),
         ({"window_size": 0}, "window_size must be an int"),
         ({"cluster_size": 0}, "cluster_size must be an int"),
         ({"cluster_size": 2.5}, "cluster_size must be an int"),
-        ({"sample_time": -1.0}, "sample_time must be > 0"),
+        ({"decimate_to": -1.0}, "decimate_to must be > 0"),
         ({"method": "lsq"}, "method must be"),
         ({"min_rows": 1}, "min_rows must be an int"),
     ],
@@ -351,7 +359,7 @@ def test_constructor_validation(kwargs, match):
 
 
 def test_data_validation():
-    a = CLPC(3, 50, 12)
+    a = CLPC(order=2, window_size=50, cluster_size=12)
     with pytest.raises(DataError, match="same length"):
         a.push(np.zeros(5), np.zeros(4))
     with pytest.raises(DataError, match="not finite at sample 3"):
@@ -361,7 +369,7 @@ def test_data_validation():
     with pytest.raises(DataError, match="reset"):
         a.push(np.zeros((5, 2)), np.zeros((5, 1)))
     with pytest.raises(DataError, match="not finite"):
-        CLPC(3, 50, 12).step(np.inf, 1.0)
+        CLPC(order=2, window_size=50, cluster_size=12).step(np.inf, 1.0)
 
 
 def test_constant_command_after_a_ramp_is_degenerate():
@@ -369,7 +377,7 @@ def test_constant_command_after_a_ramp_is_degenerate():
     rng = np.random.default_rng(13)
     u = np.r_[np.linspace(0, 1, 100), np.ones(900)]
     y = u + 1e-5 * rng.standard_normal(1000)
-    trace = CLPC(3, 201, 12).run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     late = trace.index > 400
     assert trace.degenerate[late].all()
     assert not trace.accepted[late].any()
@@ -380,7 +388,7 @@ def test_estimates_without_y_are_never_accepted():
     rng = np.random.default_rng(14)
     u = np.clip(np.arange(3000) / 1500.0, 0, 1) + 1e-7 * rng.standard_normal(3000)
     y = clpc.simulate_arx(DEN, NUM, u) + 1e-3 * rng.standard_normal(3000)
-    trace = CLPC(3, 201, 12, method="paper").run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12, method="paper").run(u, y)
     weak = trace.arrays["a0_weight"][:, 0] < 1e-3
     assert weak.any()
     assert not trace.accepted[weak].any()
@@ -389,7 +397,7 @@ def test_estimates_without_y_are_never_accepted():
 
 def test_time_uses_the_records_sample_time_without_decimation():
     u, y = record(400, noise=0.01)
-    trace = CLPC(3, 101, 12).run(clpc.IOData(u, y, dt=0.08))
+    trace = CLPC(order=2, window_size=101, cluster_size=12).run(clpc.IOData(u, y, dt=0.08))
     np.testing.assert_allclose(trace.time, trace.index * 0.08)
     assert trace.sample_time == 0.08
     model = trace.steady_state_model(allow_unconverged=True)
@@ -411,14 +419,14 @@ def test_schur_stability_matches_roots():
 def test_small_clusters_prefix_path_is_exact_and_streams(cluster):
     # W / C > 32 pieces: windows come from prefix sums re-centered per batch
     u, y = record(3000, seed=16, noise=0.05, offset=1e4)
-    trace = CLPC(3, 201, cluster, method="paper").run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=cluster, method="paper").run(u, y)
     for t in range(12, len(trace), 97):  # windows with at least 12 rows (full spectrum)
         _scatter, vals, vecs = exact_window(u, y, (t + 1) * cluster, 201)
         np.testing.assert_allclose(trace.eigenvalues[t], vals, rtol=1e-9, atol=1e-9 * vals[-1])
         if vals[0] < 0.1 * vals[1]:
             ref = vecs[0] * np.sign(vecs[0][0])
             np.testing.assert_allclose(trace.theta_estimate[t], ref, atol=1e-9)
-    a = CLPC(3, 201, cluster, method="paper")
+    a = CLPC(order=2, window_size=201, cluster_size=cluster, method="paper")
     parts = [a.push(u[i : i + 777], y[i : i + 777]) for i in range(0, 3000, 777)]
     streamed = Trace.concat(parts)
     np.testing.assert_allclose(streamed.theta, trace.theta, atol=1e-10)
@@ -428,7 +436,7 @@ def test_small_clusters_prefix_path_is_exact_and_streams(cluster):
 # ---------------------------------------------------------------- the guard
 def test_guard_accepts_only_trusted_windows():
     u, y = record(3000, seed=21, noise=0.01)
-    guarded = CLPC(3, 201, 12).run(u, y)
+    guarded = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     assert guarded.meta["guard"]
     accepted = guarded.arrays["accepted"][:, 0]
     trusted = guarded.arrays["trusted"][:, 0]
@@ -449,8 +457,8 @@ def test_guard_never_holds_a_model_from_a_quantized_start_up_window():
     y[150:300] = 1.0  # one quantization step, then the real signal
     step = 1e-2
     y = np.round(y / step) * step
-    paper = CLPC(3, 201, 12, guard=False).run(u, y)
-    guarded = CLPC(3, 201, 12).run(u, y)
+    paper = CLPC(order=2, window_size=201, cluster_size=12, guard=False).run(u, y)
+    guarded = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     early = guarded.index < 300
     assert paper.arrays["accepted"][early].any()
     assert not guarded.arrays["accepted"][early].any()
@@ -460,7 +468,7 @@ def test_guard_never_holds_a_model_from_a_quantized_start_up_window():
 def test_no_relation_nothing_trusted_and_no_convergence():
     rng = np.random.default_rng(23)
     u, y = rng.standard_normal(3000), rng.standard_normal(3000)
-    trace = CLPC(3, 201, 12).run(u, y)
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     assert not trace.arrays["trusted"].any() and not trace.has_model.any()
     conv = trace.convergence(theta_tol=10.0, D_tol=10.0)  # tolerances that anything meets
     assert not conv.converged and conv.trusted_fraction == 0.0
@@ -474,12 +482,9 @@ def test_no_relation_nothing_trusted_and_no_convergence():
 def test_guard_settings_are_checked_and_saved(tmp_path):
     with pytest.raises(ValueError, match="guard must be True or False"):
         CLPC(guard="no")
-    a = CLPC(3, 60, 6, guard=False, trust_rows=30)
+    a = CLPC(order=2, window_size=60, cluster_size=6, guard=False, trust_rows=30)
     assert CLPC.from_state_dict(a.state_dict()).trust_rows == 30
     assert not CLPC.from_state_dict(a.state_dict()).guard
-    assert CLPC(gate=False).guard is False  # the former name
-    with pytest.raises(ValueError, match="former name of guard"):
-        CLPC(guard=False, gate=True)
 
 
 @pytest.mark.parametrize("name", ["dryer", "robot_arm", "ballbeam", "exchanger"])
@@ -487,7 +492,7 @@ def test_default_guard_never_holds_an_untrusted_model_on_real_records(name):
     from clpc import datasets
 
     data = datasets.load(name)
-    trace = CLPC(3, 201, 12).run(data)
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(data)
     acc, trusted = trace.arrays["accepted"], trace.arrays["trusted"]
     assert not (acc & ~trusted).any()
     # every held parameter vector is one a trusted window produced
@@ -498,7 +503,8 @@ def test_default_guard_never_holds_an_untrusted_model_on_real_records(name):
 
 
 def test_convergence_of_a_trace_without_updates():
-    trace = CLPC(3, 201, 12).run(np.arange(10.0), np.arange(10.0))  # 8 lag rows: no update
+    # 8 lag rows: no update
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(np.arange(10.0), np.arange(10.0))
     assert len(trace) == 0
     conv = trace.convergence()
     assert not conv.converged and conv.reason
@@ -516,7 +522,8 @@ def test_windows_that_can_never_hold_a_model_are_refused_up_front():
     with pytest.raises(ValueError, match="window_size=3 cannot hold the 12 lag vectors"):
         CLPC(window_size=3)
     with pytest.raises(ValueError, match="1000 parameters need"):
-        CLPC(parameters_size=500)
-    miso = CLPC(3, 13, 1, mimo="miso")  # 12 parameters with 3 inputs: known at the data
+        CLPC(order=499)
+    # 12 parameters with 3 inputs: known at the data
+    miso = CLPC(order=2, window_size=13, cluster_size=1, mimo="miso")
     with pytest.raises(ValueError, match="window_size=13 cannot hold the 24"):
         miso.run(np.ones((100, 3)), np.ones(100))

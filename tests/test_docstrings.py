@@ -26,22 +26,6 @@ PACKAGES = (
     "clpc.report",
 )
 
-# being rewritten by issue 24's appraiser change; to be documented at its merge
-# (each of these is defined under src/clpc/appraiser/)
-PENDING = {
-    "clpc.CLPC.from_state_dict",
-    "clpc.CLPC.load",
-    "clpc.CLPC.save",
-    "clpc.Trace",
-    "clpc.Trace.allocate",
-    "clpc.Trace.concat",
-    "clpc.Trace.convergence",
-    "clpc.Trace.held",
-    "clpc.Trace.put",
-    "clpc.appraiser.usable",
-    "clpc.report.trace_columns",
-}
-
 #: a section heading of a numpydoc docstring, underlined
 _SECTION = re.compile(r"^(\s*)([A-Z][A-Za-z ]+)\n\1-{3,}\s*$", re.M)
 
@@ -120,8 +104,6 @@ CASES = list(public_callables())
 
 @pytest.mark.parametrize(("name", "fn", "doc"), CASES, ids=[c[0] for c in CASES])
 def test_every_parameter_is_documented(name, fn, doc):
-    if name in PENDING:
-        pytest.skip("being rewritten by issue 24's appraiser change; documented at its merge")
     want = wanted(fn)
     if inspect.isclass(fn):
         want = (

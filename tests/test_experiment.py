@@ -270,8 +270,10 @@ def test_extended_ramp_leaves_nothing_to_identify(run: tuple[dict[str, Any], Pat
 def test_decimate_matches_the_appraiser(rng: np.random.Generator) -> None:
     u = np.cumsum(rng.standard_normal(3000)) * 0.01
     y = signal.lfilter([0.0, 0.2], [1.0, -0.8], u) + 1e-3 * rng.standard_normal(3000)
-    fast = clpc.CLPC(3, 60, 12, decimate_to=0.01).run(u, y, dt=0.001)
-    slow = clpc.CLPC(3, 60, 12, decimate_to=0.01).run(decimate(u, 10), decimate(y, 10), dt=0.01)
+    fast = clpc.CLPC(order=2, window_size=60, cluster_size=12, decimate_to=0.01).run(u, y, dt=0.001)
+    slow = clpc.CLPC(order=2, window_size=60, cluster_size=12, decimate_to=0.01).run(
+        decimate(u, 10), decimate(y, 10), dt=0.01
+    )
     np.testing.assert_array_equal(fast.index, slow.index)
     np.testing.assert_allclose(fast.theta, slow.theta, atol=1e-12)
 
@@ -304,7 +306,7 @@ def test_free_run_reproduces_noise_free_data(make_model, rich_input) -> None:
 def test_online_prediction_is_exact_on_noise_free_data(siso2, rich_input) -> None:
     u = rich_input(1500)
     y = siso2.output(u)
-    trace = clpc.CLPC(3, 100, 12, dt=1.0).run(u, y)
+    trace = clpc.CLPC(order=2, window_size=100, cluster_size=12, dt=1.0).run(u, y)
     for k in (1, 10):
         res = analysis.online_prediction(trace, u, y, k)
         assert res["fit"] > 100.0 - 1e-6

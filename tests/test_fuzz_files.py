@@ -43,7 +43,7 @@ def record():
 @pytest.fixture(scope="module")
 def base_state(record):
     u, y = record
-    a = CLPC(3, 101, 12, decimate_to=0.02, dt=0.01)
+    a = CLPC(order=2, window_size=101, cluster_size=12, decimate_to=0.02, dt=0.01)
     a.push(u[:SPLIT], y[:SPLIT])
     return json.loads(json.dumps(a.state_dict()))
 

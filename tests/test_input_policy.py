@@ -29,8 +29,8 @@ def uy():
 ENTRY = {
     "IOData": lambda u, y: IOData(u, y),
     "LPC": lambda u, y: LPC(na=2, nb=2).fit(u, y),
-    "CLPC.run": lambda u, y: CLPC(3, 201, 12).run(u, y),
-    "CLPC.push": lambda u, y: CLPC(3, 201, 12).push(u, y),
+    "CLPC.run": lambda u, y: CLPC(order=2, window_size=201, cluster_size=12).run(u, y),
+    "CLPC.push": lambda u, y: CLPC(order=2, window_size=201, cluster_size=12).push(u, y),
 }
 
 
@@ -101,21 +101,22 @@ def test_extreme_scales_are_refused_by_both_estimators_without_warnings(
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(DataError, match=match):
-            CLPC(3, 201, 12).run(u * scale_u, y * scale_y)
+            CLPC(order=2, window_size=201, cluster_size=12).run(u * scale_u, y * scale_y)
         with pytest.raises(DataError, match=match):
             LPC(na=2, nb=2).fit(u * scale_u, y * scale_y)
 
 
 def test_scales_within_the_limits_still_work_and_std_scaling_lifts_the_spread(uy):
     u, y = uy
-    ref = CLPC(3, 201, 12).run(u, y)
-    same = CLPC(3, 201, 12).run(u * 1e-60, y * 1e-60)  # homogeneous: theta unchanged
+    ref = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    # homogeneous: theta unchanged
+    same = CLPC(order=2, window_size=201, cluster_size=12).run(u * 1e-60, y * 1e-60)
     np.testing.assert_allclose(same.theta, ref.theta, rtol=1e-6, atol=1e-9)
     assert same.accepted.sum() == ref.accepted.sum()
     factor = 10 * MAX_SPREAD
     m = LPC(na=2, nb=2, scaling="std").fit(u * factor, y)
     np.testing.assert_allclose(m.den, DEN, atol=0.01)
-    tr = CLPC(3, 201, 12, scaling="std").run(u * factor, y)
+    tr = CLPC(order=2, window_size=201, cluster_size=12, scaling="std").run(u * factor, y)
     assert tr.accepted.sum() > 0.9 * len(tr)
 
 
@@ -124,12 +125,12 @@ def test_clear_errors_for_careless_arguments():
         IOData([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], dt=True)
     with pytest.raises(DataError, match="dt"):
         IOData([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], dt=10**400)
-    with pytest.raises(ValueError, match="sample_time"):
-        CLPC(sample_time=True)
-    with pytest.raises(ValueError, match="sample_time"):
-        CLPC(sample_time=10**400)
+    with pytest.raises(ValueError, match="decimate_to"):
+        CLPC(decimate_to=True)
+    with pytest.raises(ValueError, match="decimate_to"):
+        CLPC(decimate_to=10**400)
     with pytest.raises(ValueError, match="guard"):
-        CLPC(gate="no")
+        CLPC(guard="no")
     with pytest.raises(DataError, match="empty"):
         CLPC().run(np.array([]), np.array([]))
     with pytest.raises(ValueError, match="noise_cov must hold numbers"):

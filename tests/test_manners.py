@@ -33,7 +33,7 @@ def arm():
 
 @pytest.fixture(scope="module")
 def trace(dryer):
-    return clpc.CLPC(3, 201, 12, sample_time=dryer.dt).run(dryer)
+    return clpc.CLPC(order=2, window_size=201, cluster_size=12, dt=dryer.dt).run(dryer)
 
 
 class _Balanced(HTMLParser):

@@ -177,7 +177,9 @@ def test_cascaded_tanks_no_worse_than_least_squares():
 
 def test_operating_point_diagnostics_and_steady_state_warning(nonlinear):
     ident, _, _ = nonlinear
-    trace = clpc.CLPC(3, 201, 12).run(ident.command, ident.position, dt=0.01)
+    trace = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(
+        ident.command, ident.position, dt=0.01
+    )
     rep = operating_point_diagnostics(trace, ident.command, ident.position)
     assert rep.multimodel_recommended and rep.windows_local
     assert "multi-model is recommended" in rep.verdict
@@ -189,7 +191,7 @@ def test_operating_point_diagnostics_and_steady_state_warning(nonlinear):
     rng = np.random.default_rng(2)
     u = rng.standard_normal(6000)
     y = clpc.simulate_arx([1, -1.5, 0.7], [0, 0.5, 0.3], u) + 0.01 * rng.standard_normal(6000)
-    lin = clpc.CLPC(3, 201, 12).run(u, y, dt=0.01)
+    lin = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(u, y, dt=0.01)
     assert not operating_point_diagnostics(lin, u, y).multimodel_recommended
 
 

@@ -36,7 +36,7 @@ def dryer():
 @pytest.fixture(scope="module")
 def trace(dryer):
     # cluster 5 < min_rows (12): the first updates are flagged not_enough_data / not accepted
-    return clpc.CLPC(3, 201, 5, sample_time=dryer.dt).run(dryer)
+    return clpc.CLPC(order=2, window_size=201, cluster_size=5, dt=dryer.dt).run(dryer)
 
 
 @pytest.fixture(scope="module")
@@ -63,7 +63,7 @@ def test_plot_trace_marks_flagged_updates(trace, tmp_path):
 
 def test_plot_trace_mimo(mimo, tmp_path):
     data, _ = mimo
-    tr = clpc.CLPC(3, 101, 12).run(data)
+    tr = clpc.CLPC(order=2, window_size=101, cluster_size=12).run(data)
     fig = plotting.plot_trace(tr, tmp_path / "t.png")
     assert _wrote(fig, tmp_path / "t.png")
     assert len([a for a in fig.axes if a.get_visible()]) == 2 * (1 + len(tr.labels()))

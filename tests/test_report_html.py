@@ -110,7 +110,7 @@ def dryer():
 @pytest.fixture(scope="module")
 def track_report(dryer, tmp_path_factory):
     out = tmp_path_factory.mktemp("track")
-    trace = clpc.CLPC(3, 201, 12, sample_time=dryer.dt).run(dryer)
+    trace = clpc.CLPC(order=2, window_size=201, cluster_size=12, dt=dryer.dt).run(dryer)
     files = report.write_track_report(
         out, trace, title="CLPC track report: dryer", settings={"file": "x.csv", "w": 201},
         data=dryer, data_note="the whole record",
@@ -183,7 +183,7 @@ def test_linked_images_exist_beside_the_report(dryer, tmp_path):
 
 def test_report_without_dt_is_labelled_in_samples(tmp_path):
     data = ds.load("robot_arm")  # no sample time
-    trace = clpc.CLPC(3, 201, 12).run(data)
+    trace = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(data)
     files = report.write_track_report(tmp_path, trace, data=data)
     assert "[s]" not in files[-1].read_text()
     model = clpc.LPC(order=2).fit(data)

@@ -98,7 +98,7 @@ def test_long_stream_with_bad_lines_matches_a_batch_run_in_flat_memory():
     for t in threads:
         t.join(timeout=60)
     assert proc.returncode == 0
-    ref = clpc.CLPC(3, 201, 12).run(u, y)
+    ref = clpc.CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     assert count == len(ref)
     got = json.loads(last)
     np.testing.assert_array_equal(np.asarray(got["theta"]), ref.theta[-1])

@@ -23,7 +23,7 @@ def saved():
     rng = np.random.default_rng(31)
     u = rng.standard_normal(3000)
     y = clpc.simulate_arx(DEN, NUM, u) + 0.01 * rng.standard_normal(3000)
-    a = CLPC(3, 201, 12)
+    a = CLPC(order=2, window_size=201, cluster_size=12)
     a.push(u[:2000], y[:2000])
     return json.loads(json.dumps(a.state_dict())), u, y
 
@@ -70,7 +70,7 @@ def test_tampered_states_are_refused_with_the_field(saved, what, edit, match):
 
 def test_untampered_state_continues_identically(saved):
     state, u, y = saved
-    whole = CLPC(3, 201, 12).run(u, y)
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     resumed = CLPC.from_state_dict(copy.deepcopy(state)).push(u[2000:], y[2000:])
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
 
@@ -83,8 +83,35 @@ def test_state_saved_with_an_engine_setting_still_restores(saved):
     state["config"]["engine"] = "compiled"
     state["digest"] = digest(state)
     resumed = CLPC.from_state_dict(state).push(u[2000:], y[2000:])
-    whole = CLPC(3, 201, 12).run(u, y)
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
     np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
+
+
+def test_state_saved_with_the_former_names_is_mapped_once(saved):
+    # states saved before one name per setting: parameters_size (N + 1) and gate
+    from clpc.appraiser.state import digest
+
+    state, u, y = copy.deepcopy(saved[0]), saved[1], saved[2]
+    cfg = state["config"]
+    cfg["parameters_size"] = cfg.pop("order") + 1
+    cfg["gate"] = cfg.pop("guard")
+    state["digest"] = digest(state)
+    restored = CLPC.from_state_dict(state)
+    assert (restored.order, restored.guard) == (2, True)
+    assert "parameters_size" not in restored.state_dict()["config"]
+    whole = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    resumed = restored.push(u[2000:], y[2000:])
+    np.testing.assert_array_equal(resumed.theta, whole.theta[-len(resumed) :])
+
+
+def test_state_saved_with_the_ambiguous_sample_time_is_refused(saved):
+    from clpc.appraiser.state import digest
+
+    state = copy.deepcopy(saved[0])
+    state["config"]["sample_time"] = state["config"].pop("decimate_to") or 1.0
+    state["digest"] = digest(state)
+    with pytest.raises(StateError, match="ambiguous sample_time"):
+        CLPC.from_state_dict(state)
 
 
 @pytest.mark.parametrize(
@@ -147,3 +174,34 @@ def test_json_depth_counts_brackets_outside_strings_only():
     assert parse_json('{"a": "\\"' + "[" * 50 + '"}') == {"a": '"' + "[" * 50}
     with pytest.raises(StateError, match="nested deeper"):
         parse_json('{"a": "\\\\"' + ", " + '"b": ' + "[" * 50 + "]" * 50 + "}")
+
+
+def test_a_save_that_fails_midway_leaves_the_previous_state_whole(tmp_path, monkeypatch):
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(600)
+    y = clpc.simulate_arx([1, -0.5], [0, 1.0], u)
+    appraiser = clpc.CLPC(order=1, window_size=101, cluster_size=10)
+    appraiser.push(u[:300], y[:300])
+    path = tmp_path / "state.json"
+    appraiser.save(str(path))
+    good = path.read_bytes()
+    appraiser.push(u[300:], y[300:])
+
+    def broken(obj, fh):
+        fh.write('{"format": "clpc')  # part of the file, then the process dies
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("clpc.appraiser.clpc.json.dump", broken)
+    with pytest.raises(KeyboardInterrupt):
+        appraiser.save(str(path))
+    assert path.read_bytes() == good
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["state.json"]  # no temporary left
+    np.testing.assert_array_equal(
+        clpc.CLPC.load(str(path)).push(u[300:], y[300:]).theta, appraiser_after(u, y).theta
+    )
+
+
+def appraiser_after(u, y):
+    fresh = clpc.CLPC(order=1, window_size=101, cluster_size=10)
+    fresh.push(u[:300], y[:300])
+    return fresh.push(u[300:], y[300:])

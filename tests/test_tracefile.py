@@ -11,9 +11,9 @@ def parts_and_whole():
     rng = np.random.default_rng(0)
     u = rng.standard_normal(6000)
     y = clpc.simulate_arx([1, -1.5, 0.7], [0.2, 0.5, 0.1], u) + 0.01 * rng.standard_normal(6000)
-    a = CLPC(3, 101, 12)
+    a = CLPC(order=2, window_size=101, cluster_size=12)
     parts = [a.push(u[i : i + 700], y[i : i + 700]) for i in range(0, 6000, 700)]
-    return parts, CLPC(3, 101, 12).run(u, y)
+    return parts, CLPC(order=2, window_size=101, cluster_size=12).run(u, y)
 
 
 @pytest.mark.parametrize("ext", ["csv", "parquet"])

@@ -36,7 +36,7 @@ def test_summary_counts_convergence_and_model_come_from_the_full_trace(long_reco
         save=str(tmp_path / "ss.json"),
     )
     result = wf.track_file(settings)
-    full = clpc.CLPC(3, 101, 10, nk=1).run(u, y)
+    full = clpc.CLPC(order=2, window_size=101, cluster_size=10, nk=1).run(u, y)
     assert len(full) > 8 * 40  # long enough to be thinned
     table = read_table(tmp_path / "trace.csv")
     assert table.n_rows == len(full)
@@ -64,7 +64,7 @@ def test_the_whole_record_is_kept_in_104_bytes_per_update(long_record):
     from clpc.workflows.track import _SummaryTrace
 
     _, u, y = long_record
-    full = clpc.CLPC(3, 101, 10).run(u, y)
+    full = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)
     kept = _SummaryTrace()
     kept.add(full)
     whole = kept.trace()

@@ -34,15 +34,16 @@ def test_lpc_has_one_name_for_its_order():
         clpc.LPC(parameters_size=4)
 
 
-def test_clpc_order_equals_parameters_size(record):
-    u, y = record
-    a = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)
-    b = clpc.CLPC(3, 101, 10).run(u, y)
-    np.testing.assert_array_equal(a.theta, b.theta)
-    assert clpc.CLPC(order=4).parameters_size == 5
+def test_clpc_has_one_name_per_setting():
     assert "order=2" in repr(clpc.CLPC())
-    with pytest.raises(ValueError, match="parameters_size"):
-        clpc.CLPC(3, order=3)
+    for former in ("parameters_size", "data_cluster_dimension", "sample_time", "gate"):
+        with pytest.raises(TypeError, match=former):
+            clpc.CLPC(**{former: 3})
+    with pytest.raises(TypeError, match="data_sample_time"):
+        clpc.CLPC(data_sample_time=0.01)
+    with pytest.raises(TypeError):
+        clpc.CLPC(3, 101, 10)  # type: ignore[misc]  # settings are named, never positional
+    assert not hasattr(clpc.CLPC(), "parameters_size")
 
 
 def test_the_papers_names_are_not_settings(record):
@@ -61,19 +62,15 @@ def test_dt_and_decimate_to_are_unambiguous(record):
     u, y = record
     new = clpc.CLPC(order=2, window_size=101, cluster_size=5, dt=0.01, decimate_to=0.02)
     got = new.run(u, y)
-    with pytest.warns(DeprecationWarning, match="taken as the decimation target"):
-        old = clpc.CLPC(3, 101, 5, sample_time=0.02).run(u, y, 0.01)
-    np.testing.assert_array_equal(got.theta, old.theta)
-    assert got.sample_time == 0.02 and len(got) == len(old) > 0
+    same = clpc.CLPC(order=2, window_size=101, cluster_size=5, decimate_to=0.02).run(u, y, 0.01)
+    np.testing.assert_array_equal(got.theta, same.theta)
+    assert got.sample_time == 0.02 and len(got) == len(same) > 0
     # the data's own sample time: no decimation, the trace's time axis in seconds
     plain = clpc.CLPC(order=2, window_size=101, cluster_size=5, dt=0.01).run(u, y)
     assert plain.sample_time == 0.01 and len(plain) > len(got)
-    with pytest.warns(DeprecationWarning, match="taken as the data's sample time"):
-        legacy = clpc.CLPC(3, 101, 5, sample_time=0.01).run(u, y)
-    np.testing.assert_array_equal(legacy.theta, plain.theta)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the same rate: nothing ambiguous, no warning
-        clpc.CLPC(3, 101, 5, sample_time=0.01).run(u, y, 0.01)
+        clpc.CLPC(order=2, window_size=101, cluster_size=5, decimate_to=0.01).run(u, y, 0.01)
 
 
 def test_decimate_to_needs_the_data_rate_and_dt_must_agree(record):
@@ -82,10 +79,6 @@ def test_decimate_to_needs_the_data_rate_and_dt_must_agree(record):
         clpc.CLPC(decimate_to=0.02).run(u, y)
     with pytest.raises(clpc.DataError, match="must agree"):
         clpc.CLPC(dt=0.01).run(clpc.IOData(u, y, dt=0.02))
-    with pytest.raises(ValueError, match="former, ambiguous name"):
-        clpc.CLPC(sample_time=0.01, decimate_to=0.02)
-    with pytest.raises(ValueError, match="dt and data_sample_time"):
-        clpc.CLPC(dt=0.01, data_sample_time=0.02)
 
 
 def test_state_round_trip_keeps_the_new_names(record):

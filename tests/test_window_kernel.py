@@ -115,7 +115,7 @@ PARITY_CASES = [
     ({"noise_ratio": 3.0}, 1, 1),
     ({"method": "paper", "noise_cov": [1, 1.1, 1.2, 2, 2.1, 2.2]}, 1, 1),
     ({"noise_cov": np.diag([1, 1.1, 1.2, 2, 2.1, 2.2]) + 0.05}, 1, 1),
-    ({"gate": True, "window_size": 60, "cluster_size": 7}, 1, 1),
+    ({"guard": True, "window_size": 60, "cluster_size": 7}, 1, 1),
     ({"na": 3, "nb": 1, "nk": 2, "window_size": 24, "cluster_size": 12}, 1, 1),
     ({"cluster_size": 1, "window_size": 40}, 1, 1),
     ({"mimo": "miso"}, 2, 2),
@@ -126,7 +126,7 @@ PARITY_CASES = [
 @pytest.mark.parametrize(("kwargs", "n_in", "n_out"), PARITY_CASES)
 def test_kernel_equals_per_window_svd_reference(kwargs, n_in, n_out):
     u, y = _record(3000, seed=3, n_in=n_in, n_out=n_out, offset=1e3)
-    settings = {"parameters_size": 3, "window_size": 201, "cluster_size": 12, **kwargs}
+    settings = {"order": 2, "window_size": 201, "cluster_size": 12, **kwargs}
     appraiser = CLPC(**settings)
     _compare(appraiser.run(u, y), reference_clpc(u, y, appraiser))
 
@@ -146,7 +146,7 @@ def kernel_outputs(inputs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 
     out = {}
     for i, (kwargs, _, _) in enumerate(UNCOMPILED_CASES):
-        settings = {"parameters_size": 3, "window_size": 101, "cluster_size": 12, **kwargs}
+        settings = {"order": 2, "window_size": 101, "cluster_size": 12, **kwargs}
         trace = CLPC(**settings).run(inputs[f"clpc_u{i}"], inputs[f"clpc_y{i}"])
         out.update({f"clpc{i}_{key}": trace.arrays[key] for key in UNCOMPILED_KEYS})
     models = (inputs["den"], inputs["num"], inputs["icpt"])
@@ -222,7 +222,7 @@ def test_kernel_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
         2000
     )
     for gate in (False, True):
-        appraiser = CLPC(3, 101, 12, gate=gate)
+        appraiser = CLPC(order=2, window_size=101, cluster_size=12, guard=gate)
         fast = appraiser.run(u, y)
         ref = reference_clpc(u, y, appraiser)
         np.testing.assert_array_equal(fast.degenerate, ref["degenerate"][:, 0])
@@ -237,10 +237,10 @@ def test_kernel_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
 def test_compiled_stream_and_step_are_bit_identical_to_run():
     u, y = _record(2000, seed=9, offset=1e4)
     u, y = u[:, 0], y[:, 0]
-    batch = CLPC(3, 201, 12).run(u, y)
-    a = CLPC(3, 201, 12)
+    batch = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
+    a = CLPC(order=2, window_size=201, cluster_size=12)
     pushed = Trace.concat([a.push(u[i : i + 97], y[i : i + 97]) for i in range(0, 2000, 97)])
-    b = CLPC(3, 201, 12)
+    b = CLPC(order=2, window_size=201, cluster_size=12)
     # python and numpy scalars take the light path, arrays the general one
     feeds = [float, np.float64, lambda v: np.array([v])]
     stepped = [b.step(feeds[k % 3](u[k]), feeds[k % 3](y[k])) for k in range(2000)]
@@ -255,14 +255,14 @@ def test_step_with_integer_and_float32_samples():
     rng = np.random.default_rng(2)
     u = rng.integers(-5, 6, 400)
     y = clpc.simulate_arx(DEN, NUM, u.astype(float)).round(3).astype(np.float32)
-    ref = CLPC(3, 60, 12).run(u.astype(float), y.astype(float))
-    a = CLPC(3, 60, 12)
+    ref = CLPC(order=2, window_size=60, cluster_size=12).run(u.astype(float), y.astype(float))
+    a = CLPC(order=2, window_size=60, cluster_size=12)
     stepped = Trace.concat([a.step(int(u[k]), y[k]) for k in range(400)])
     np.testing.assert_array_equal(stepped.theta, ref.theta)
 
 
 def test_step_rejects_non_finite_scalars_with_the_sample_index():
-    a = CLPC(3, 60, 12)
+    a = CLPC(order=2, window_size=60, cluster_size=12)
     for k in range(5):
         a.step(float(k), 1.0 + k)
     with pytest.raises(DataError, match="y channel 0 is not finite at sample 5"):

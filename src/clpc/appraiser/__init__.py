@@ -4,9 +4,9 @@
 updates of a :class:`Trace` that count for its convergence and steady state.
 """
 
+from clpc.appraiser.clpc import CLPC
 from clpc.appraiser.convergence import usable
 from clpc.appraiser.decimation import decimate
-from clpc.appraiser.facade import CLPC
 from clpc.appraiser.trace import Convergence, Trace
 
 __all__ = ["CLPC", "Convergence", "Trace", "decimate", "usable"]

@@ -76,6 +76,15 @@ def usable(trace: Any) -> np.ndarray:
 
     Accepted, holding a model and from a trusted window, for every equation (traces
     without a ``trusted`` column: accepted and holding a model).
+
+    Parameters
+    ----------
+    trace : Trace
+        A CLPC trace.
+
+    Returns
+    -------
+    ndarray of bool, shape (n_updates,)
     """
     arrays = trace.arrays
     ok = arrays["accepted"].all(axis=1) & arrays["has_model"].all(axis=1)

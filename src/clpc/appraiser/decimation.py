@@ -33,10 +33,9 @@ def decimation_factor(target: float | None, data_dt: float | None) -> int:
     factor = round(ratio)
     if factor < 1 or abs(ratio - factor) > FACTOR_RTOL * max(ratio, 1.0):
         raise DataError(
-            f"decimate_to={target:g} s (the rate the appraiser works at; former name "
-            f"sample_time) must be an integer multiple of the data's sample time dt = "
-            f"{data_dt:g} s (ratio {ratio:g}); resample the data or choose decimate_to "
-            "accordingly."
+            f"decimate_to={target:g} s (the rate the appraiser works at) must be an integer "
+            f"multiple of the data's sample time dt = {data_dt:g} s (ratio {ratio:g}); resample "
+            "the data or choose decimate_to accordingly."
         )
     return factor
 
@@ -54,13 +53,17 @@ class Decimator:
     Parameters
     ----------
     factor : int
-        Decimation factor (``sample_time / data_sample_time``), >= 1.
+        Decimation factor (``decimate_to / dt``), >= 1.
+    zi : ndarray, optional
+        The filter's state, (sections, 2, channels) (``None``: at rest at the first sample).
+    phase : int
+        Samples fed so far, modulo ``factor``.
     """
 
-    def __init__(self, factor: int) -> None:
+    def __init__(self, factor: int, zi: np.ndarray | None = None, phase: int = 0) -> None:
         self.factor = int(factor)
-        self.zi: np.ndarray | None = None  # filter state, (sections, 2, channels)
-        self.phase = 0  # samples fed so far, modulo factor
+        self.zi = zi
+        self.phase = phase
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """Decimate the next chunk ``x`` (T, channels); returns the kept samples."""

@@ -6,10 +6,18 @@ from typing import Any
 
 import numpy as np
 
-from clpc.data import DataError
+from clpc.core.checks import check_positive
+from clpc.data import DataError, IOData, as_iodata
 from clpc.data.samples import as_samples
 
-__all__ = ["SCALAR_TYPES", "as_columns", "check_finite", "check_noise_cov"]
+__all__ = [
+    "SCALAR_TYPES",
+    "as_chunk",
+    "as_columns",
+    "as_record",
+    "check_finite",
+    "check_noise_cov",
+]
 
 #: scalar sample types :meth:`clpc.CLPC.step` takes without building arrays
 SCALAR_TYPES = frozenset({float, int, np.float64, np.float32, np.int64, np.int32})
@@ -74,3 +82,33 @@ def check_finite(arr: np.ndarray, name: str, offset: int) -> None:
                 f"{name} channel {col} is not finite at sample {offset + lo + row} (counting "
                 "from the first sample fed); remove or interpolate missing samples."
             )
+
+
+def as_chunk(u: Any, y: Any, offset: int) -> tuple[np.ndarray, np.ndarray]:
+    """A chunk of samples as columns of the same length, finite (``offset``: samples before)."""
+    u2, y2 = as_columns(u, "u"), as_columns(y, "y")
+    if u2.shape[0] != y2.shape[0]:
+        raise DataError(
+            f"u and y must have the same length; got len(u)={u2.shape[0]}, len(y)={y2.shape[0]}."
+        )
+    check_finite(u2, "u", offset)
+    check_finite(y2, "y", offset)
+    return u2, y2
+
+
+def as_record(u: Any, y: Any, dt: Any) -> tuple[np.ndarray, np.ndarray, float | None, Any]:
+    """One continuous record: ``(u, y, its sample time or None, channel names or None)``."""
+    if isinstance(u, np.ndarray) and isinstance(y, np.ndarray):
+        # plain arrays: checked by push, without IOData's defensive copy of the record
+        u_arr = as_columns(u, "u", allow_empty=False)
+        y_arr = as_columns(y, "y", allow_empty=False)
+        return u_arr, y_arr, None if dt is None else check_positive(dt, "dt", "s"), None
+    data = as_iodata(u, y, dt)
+    if data.n_experiments > 1:
+        raise DataError(
+            f"CLPC runs over one continuous record; this one holds {data.n_experiments} "
+            "experiments, and its windows would reach across their boundaries. Run each "
+            "experiment on its own (IOData.split())."
+        )
+    data_dt = data.dt if isinstance(u, IOData) or dt is not None else None
+    return data.u, data.y, data_dt, (data.input_names, data.output_names)

@@ -4,6 +4,9 @@ Plain ``numba.njit(cache=True)`` functions; with ``NUMBA_DISABLE_JIT=1`` numba l
 uncompiled and they run as plain Python (slow; for debugging and coverage). The rules of
 the solution are :mod:`clpc.core.rules`, the eigen-solver :mod:`clpc.core.small_eigh`, the
 monic form and the stability test :mod:`clpc.core.polynomials`: nothing here restates them.
+The Python side at the end (:func:`window_plan`, :func:`solve_updates`, ...) builds a record's
+plan and settings, allocates the output arrays of a call and cuts the updates into batches
+(solved on threads with ``n_jobs``; the FSM output then runs in time order).
 
 A window's numbers depend only on its own rows, never on how a record was chunked, so
 ``run``, ``push`` in any chunks and ``step`` give bit-identical results.
@@ -28,7 +31,9 @@ digits.
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numba
 import numpy as np
@@ -36,6 +41,7 @@ import numpy as np
 from clpc.core.polynomials import monic, schur_stable
 from clpc.core.rules import (
     NO_TRANSFORM,
+    RobustRule,
     SolveSettings,
     accepts,
     eig_ratio,
@@ -44,11 +50,35 @@ from clpc.core.rules import (
     is_excited,
     is_trusted,
     likelihood_variance,
+    solve_settings,
+    transform_mode,
+    trust_rows,
 )
 from clpc.core.small_eigh import sym_eig
 from clpc.core.solution import channel_scales, solve_from_eig, solved_matrix
+from clpc.lpc.solve import fixed_transform, noise_covariance
+from clpc.model.structure import Structure
 
-__all__ = ["FsmOutput", "FsmSettings", "FsmState", "Solved", "WindowPlan", "fsm_output"]
+if TYPE_CHECKING:
+    from clpc.appraiser.settings import Settings
+
+__all__ = [
+    "FsmOutput",
+    "FsmSettings",
+    "FsmState",
+    "KernelSetup",
+    "Solved",
+    "WindowPlan",
+    "batches",
+    "fsm_output",
+    "output",
+    "record_setup",
+    "settings_for",
+    "solve",
+    "solve_updates",
+    "update",
+    "window_plan",
+]
 
 
 class WindowPlan(NamedTuple):
@@ -467,3 +497,276 @@ def update_windows(
     solved = Solved(*out[0])
     solve_windows(samples, first_row, windows, plan, s, solved)
     fsm_output(solved, fs, FsmState(*state), FsmOutput(*out[1]))
+
+
+# ================================================================= the Python side
+# The appraiser's calls into the compiled functions above: the plan and settings of a
+# record, the output arrays of a call, batches of windows (on threads with ``n_jobs``).
+
+#: windows solved per kernel call (bounds the temporaries of one call)
+WINDOWS_PER_BATCH = 2048
+
+
+@dataclass(frozen=True)
+class KernelSetup:
+    """What the kernel needs, fixed for a record: the plan and the settings."""
+
+    plan: WindowPlan
+    settings: SolveSettings
+    fsm: FsmSettings
+    n_inputs: int
+    plain: tuple[tuple[Any, ...], ...] = ()  #: (plan, settings, fsm) as plain tuples
+
+    def __post_init__(self) -> None:
+        # what the kernel's entry point takes (fast to type at every call)
+        plain = (tuple(self.plan), tuple(self.settings), tuple(self.fsm))
+        object.__setattr__(self, "plain", plain)
+
+
+def record_setup(
+    settings: Settings, channels: tuple[int, int, bool], p: int, min_rows: int
+) -> KernelSetup:
+    """The plan and settings of a record.
+
+    ``channels = (n_inputs, n_outputs, miso)``; ``p`` parameters per equation; windows of
+    fewer than ``min_rows`` rows are not solved.
+    """
+    st, s = settings, settings.structure
+    n_in, _, miso = channels
+    cov = noise_covariance(st.noise_cov, st.noise_ratio, s, n_in if miso else 1)
+    plan, n_channels = window_plan(s, channels, (st.window_size, st.cluster_size, min_rows), cov)
+    trusted = trust_rows(p, st.window_size) if st.trust_rows is None else st.trust_rows
+    return KernelSetup(
+        plan=plan,
+        settings=settings_for((st.method, st.scaling), st.rule, cov, s.na, n_channels),
+        fsm=FsmSettings(
+            min_rows, st.guard, trusted, st.rule.separation, s.na, s.nb, s.nk, not miso
+        ),
+        n_inputs=n_in,
+    )
+
+
+def window_plan(
+    structure: Structure,
+    channels: tuple[int, int, bool],
+    sizes: tuple[int, int, int],
+    noise: np.ndarray | None,
+) -> tuple[WindowPlan, int]:
+    """Column maps of the lag rows and the transform of the solved problem.
+
+    Parameters
+    ----------
+    structure : Structure
+    channels : (n_inputs, n_outputs, miso)
+        ``miso``: every equation uses every input (else the paper's pairing).
+    sizes : (window, cluster, min_rows)
+    noise : ndarray, shape (p,) or (p, p), optional
+        Known noise covariance of the lag vector (weighted LPC).
+
+    Returns
+    -------
+    plan : WindowPlan
+    n_channels : int
+        Channel blocks of a lag vector (the output, then one per input block).
+    """
+    n_in, n_out, miso = channels
+    s = structure
+    n_blocks = n_in if miso else 1
+    p = s.n_params(n_blocks)
+    col_channel = np.zeros(p, dtype=np.int64)
+    for blk in range(n_blocks):
+        col_channel[s.na + 1 + blk * (s.nb + 1) : s.na + 1 + (blk + 1) * (s.nb + 1)] = blk + 1
+    # column a of equation e is buf[k - lag, chan] (buffer columns: inputs, then outputs)
+    chan = np.empty((n_out, p), dtype=np.int64)
+    lag = np.empty((n_out, p), dtype=np.int64)
+    for e in range(n_out):
+        chan[e, : s.na + 1] = n_in + e
+        lag[e, : s.na + 1] = np.arange(s.na + 1)
+        for i, inp in enumerate(range(n_in) if miso else [e]):
+            cols = slice(s.na + 1 + i * (s.nb + 1), s.na + 1 + (i + 1) * (s.nb + 1))
+            chan[e, cols] = inp
+            lag[e, cols] = s.nk + np.arange(s.nb + 1)
+    transform = np.eye(p) if noise is None else fixed_transform(noise, p)
+    window, cluster, min_rows = sizes
+    plan = WindowPlan(
+        chan, lag, col_channel, np.ascontiguousarray(transform), window, cluster, min_rows
+    )
+    return plan, n_blocks + 1
+
+
+def settings_for(
+    method: tuple[str, str],
+    rule: RobustRule,
+    noise: np.ndarray | None,
+    na: int,
+    n_channels: int,
+) -> SolveSettings:
+    """The solve settings of an appraiser: ``method = (method, scaling)``.
+
+    See :func:`clpc.core.rules.solve_settings` and :func:`clpc.core.rules.transform_mode`.
+    """
+    name, scaling = method
+    mode = transform_mode(scaling, noise is not None)
+    return solve_settings(rule, name == "robust", mode, na + 1, n_channels)
+
+
+def update(
+    samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: KernelSetup, state: FsmState
+) -> tuple[Solved, FsmOutput]:
+    """Solve ``windows`` and run the FSM output over them in one kernel call.
+
+    Parameters
+    ----------
+    samples : (ndarray, int)
+        The buffered samples, shape (n, channels), and the absolute lag row of the first.
+    windows : (int, int)
+        ``(j0, count)``: updates ``j0 .. j0 + count - 1``.
+    setup : KernelSetup
+        The record's :class:`KernelSetup` (its ``plain`` settings go
+        to :func:`update_windows`).
+    state : FsmState
+        The carried :class:`FsmState` (updated in place).
+
+    Returns
+    -------
+    solved : Solved
+    output : FsmOutput
+    """
+    solved = _solved(windows[1], setup.plan)
+    out = _fsm_output(solved, setup.fsm, setup.n_inputs)
+    update_windows(
+        samples[0], samples[1], windows, setup.plain, tuple(state), (tuple(solved), tuple(out))
+    )
+    return solved, out
+
+
+def solve(
+    samples: np.ndarray,
+    first_row: int,
+    windows: tuple[int, int],
+    plan: WindowPlan,
+    settings: SolveSettings,
+) -> Solved:
+    """Solve ``windows = (j0, count)`` (see :func:`solve_windows`)."""
+    out = _solved(windows[1], plan)
+    solve_windows(samples, first_row, windows, plan, settings, out)
+    return out
+
+
+def output(solved: Solved, fs: FsmSettings, state: FsmState, n_inputs: int) -> FsmOutput:
+    """The FSM output of ``solved`` (``state`` is updated in place)."""
+    out = _fsm_output(solved, fs, n_inputs)
+    fsm_output(solved, fs, state, out)
+    return out
+
+
+def _solved(count: int, plan: WindowPlan) -> Solved:
+    e, p = plan.chan.shape
+    f = np.empty((2, count, e, p))  # same-shape fields share one allocation (hot path)
+    g = np.empty((4, count, e))
+    i = np.empty((2, count, e), np.int64)
+    b = np.empty((2, count, e), np.bool_)
+    fields = (*f, *g, *i, *b, np.empty(count, np.int64))
+    return Solved(*fields)
+
+
+def _fsm_output(solved: Solved, fs: FsmSettings, n_inputs: int) -> FsmOutput:
+    count, e, p = solved.theta.shape
+    b = np.empty((5, count, e), np.bool_)
+    g = np.empty((5, count, e))
+    fields = (
+        np.empty((count, e, p)),
+        np.empty((count, e)),
+        *b[:4],
+        np.empty(count, np.bool_),
+        np.empty((count, e, fs.na + 1)),
+        np.empty((count, e, n_inputs, fs.nk + fs.nb + 1)),
+        b[4],
+        *g,
+    )
+    return FsmOutput(*fields)
+
+
+def batches(j_first: int, j_last: int, n_jobs: int) -> list[tuple[int, int]]:
+    """``(j0, count)`` pairs covering updates ``j_first .. j_last`` (equal thread shares)."""
+    n_new = j_last - j_first + 1
+    n_batches = -(-n_new // WINDOWS_PER_BATCH)
+    if n_jobs > 1:
+        n_batches = -(-n_batches // n_jobs) * n_jobs
+    size = -(-n_new // n_batches)
+    return [(j0, min(size, j_last + 1 - j0)) for j0 in range(j_first, j_last + 1, size)]
+
+
+def solve_updates(
+    setup: KernelSetup,
+    samples: tuple[np.ndarray, int],
+    updates: tuple[int, int],
+    state: FsmState,
+    threads: tuple[int, Callable[..., Any]] = (1, map),
+) -> list[tuple[int, int, dict[str, np.ndarray]]]:
+    """Solve updates ``updates = (j_first, j_last)`` and run the FSM output over them.
+
+    Parameters
+    ----------
+    setup : KernelSetup
+    samples : (buffer, first_row)
+        Buffered samples (n, channels) and the absolute lag row of ``buffer[0]`` minus
+        ``max_lag`` (see :func:`solve_windows`).
+    updates : (j_first, j_last)
+    state : FsmState
+        The carried FSM state, updated in place.
+    threads : (n_jobs, map)
+        Thread count and ``map`` or a thread pool's ``map`` (batches are independent).
+
+    Returns
+    -------
+    list of (j0, count, arrays)
+        Per batch, the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION`
+        plus ``not_enough`` and ``n_rows``.
+    """
+    buf, first_row = samples
+    n_jobs, mapper = threads
+    parts = batches(updates[0], updates[1], n_jobs)
+    if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
+        run = update
+        return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
+
+    def solve_batch(batch: tuple[int, int]) -> Solved:
+        return solve(buf, first_row, batch, setup.plan, setup.settings)
+
+    solved = list(mapper(solve_batch, parts))  # windows are independent: threads
+    return [  # the FSM output runs in time order
+        (j0, count, _arrays(sol, output(sol, setup.fsm, state, setup.n_inputs)))
+        for (j0, count), sol in zip(parts, solved, strict=True)
+    ]
+
+
+def _arrays(sol: Solved, fsm: FsmOutput) -> dict[str, np.ndarray]:
+    """The per-update arrays of a trace part, from the kernel's two outputs."""
+    return {
+        "theta": fsm.theta,
+        "c": fsm.c,
+        "accepted": fsm.accepted,
+        "has_model": fsm.has_model,
+        "determined": fsm.determined,
+        "trusted": fsm.trusted,
+        "not_enough": fsm.not_enough,
+        "den": fsm.den,
+        "num": fsm.num,
+        "stable": fsm.stable,
+        "lambda_min": fsm.lambda_min,
+        "lambda_max": fsm.lambda_max,
+        "D": fsm.D,
+        "eig_ratio": fsm.eig_ratio,
+        "J": fsm.J,
+        "theta_estimate": sol.theta,
+        "eigenvalues": sol.eigenvalues,
+        "separation": sol.separation,
+        "a0_weight": sol.a0_weight,
+        "noise_variance": sol.noise_variance,
+        "n_null": sol.n_null,
+        "n_input_relations": sol.n_input_relations,
+        "degenerate": sol.degenerate,
+        "excited": sol.excited,
+        "n_rows": sol.n_rows,
+    }

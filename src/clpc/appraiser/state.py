@@ -1,247 +1,309 @@
-"""Saving and restoring an appraiser: its FSM state and configuration as JSON-safe data.
+"""The appraiser's state: the paper's FSM state, its transition and its saved form.
 
-The state is the paper's: the last window of samples, the counter (samples and updates
-seen), the last parameters, plus the decimation filter's state. Floats round-trip exactly.
+:class:`AppraiserState` holds the FSM state - the samples the next windows need, the counters, the
+last parameters, the decimation filter - and the transition (:meth:`AppraiserState.consume`:
+new samples in, the updates they complete out). :meth:`AppraiserState.to_dict` /
+:meth:`AppraiserState.from_dict` are its saved form, checked by :mod:`.state_schema`.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
-from dataclasses import asdict
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from clpc.appraiser import fsm
+from clpc.appraiser import kernel
+from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator
+from clpc.appraiser.settings import Settings
 from clpc.appraiser.state_schema import (
-    MAX_STATE_BYTES,
+    FORMAT,
+    VERSION,
     StateError,
     checked_array,
+    checked_decimator,
+    checked_flags,
+    checked_names,
+    digest,
     field,
-    parse_json,
     validate_counters,
 )
+from clpc.appraiser.trace import Trace, TraceLabels, empty_arrays
 from clpc.core.checks import check_positive
-from clpc.core.rules import RobustRule
+from clpc.data import DataError
+from clpc.lpc.regressors import miso_regressor
+from clpc.model.structure import check_mode, default_mode
 
-__all__ = [
-    "FORMAT",
-    "VERSION",
-    "StateError",
-    "config_of",
-    "digest",
-    "load",
-    "restore",
-    "save",
-    "snapshot",
-]
+__all__ = ["FORMAT", "VERSION", "AppraiserState", "digest"]
 
-FORMAT = "clpc-appraiser-state"
-VERSION = 1
+
+@dataclass(eq=False, slots=True)
+class AppraiserState:
+    """The FSM state of one record; a new one per record (:meth:`clpc.CLPC.reset`).
+
+    ``n_seen`` counts decimated samples (those kept aside included), ``j_done`` updates;
+    ``last_theta``, ``last_c``, ``has_model`` are the carried output (:class:`kernel.FsmState`).
+    ``setup``, ``labels`` and ``empty`` are fixed per record once the channels are known.
+    """
+
+    settings: Settings
+    max_lag: int = 0
+    cluster: int = 1
+    n_in: int | None = None
+    n_out: int | None = None
+    names: tuple[tuple[str, ...], tuple[str, ...]] | None = None
+    buffer: SampleBuffer | None = None
+    n_seen: int = 0
+    j_done: int = 0
+    last_theta: np.ndarray | None = None
+    last_c: np.ndarray | None = None
+    has_model: np.ndarray | None = None
+    decimator: Decimator | None = None
+    record_dt: float | None = None
+    plain: bool = False  #: no decimation: step keeps samples aside
+    plain_siso: bool = False  #: and one input, one output: step's fastest path
+    setup: kernel.KernelSetup | None = None
+    labels: TraceLabels | None = None
+    empty: Trace | None = None
+
+    def __post_init__(self) -> None:
+        self.max_lag = self.settings.structure.max_lag
+        self.cluster = self.settings.cluster_size
+
+    # ------------------------------------------------------------ the record's layout
+    def mode(self) -> str:
+        """The MIMO mode in use (validated against the channel counts)."""
+        assert self.n_in is not None and self.n_out is not None
+        chosen = self.settings.mimo or default_mode(self.n_in, self.n_out)
+        check_mode(chosen, self.n_in, self.n_out)
+        return str(chosen)
+
+    def n_blocks(self) -> int:
+        """Input blocks of a lag vector (all inputs with ``miso``, else one)."""
+        assert self.n_in is not None
+        return self.n_in if self.mode() == "miso" else 1
+
+    def n_params(self) -> int:
+        """Parameters of one equation."""
+        return self.settings.structure.n_params(self.n_blocks())
+
+    def min_rows(self) -> int:
+        """Fewest rows of a usable window (default ``2 p``)."""
+        given = self.settings.min_rows
+        return given if given is not None else 2 * self.n_params()
+
+    def time_step(self) -> float:
+        """Seconds per (decimated) sample: ``decimate_to``, else the data's, else 1."""
+        s = self.settings
+        return s.decimate_to or self.record_dt or s.dt or 1.0
+
+    def set_decimator(self, decimator: Decimator) -> None:
+        """Use ``decimator`` for the samples fed from now on."""
+        self.decimator = decimator
+        self.plain = decimator.factor == 1
+        self.plain_siso = self.plain and (self.n_in, self.n_out) == (1, 1)
+
+    def init_channels(self, n_in: int, n_out: int, names: Any = None) -> None:
+        """Fix the record's channels on first data; later chunks must match them."""
+        if self.n_in is None:
+            self.n_in, self.n_out = n_in, n_out
+            self.mode()  # validates
+            p = self.n_params()
+            self.settings.check_window(p)
+            self.buffer = SampleBuffer(n_in + n_out)
+            self.last_theta = np.zeros((n_out, p))
+            self.last_c = np.zeros(n_out)
+            self.has_model = np.zeros(n_out, dtype=bool)
+            if names is not None:
+                self.names = names
+            self.plain_siso = self.plain and (n_in, n_out) == (1, 1)
+        elif (n_in, n_out) != (self.n_in, self.n_out):
+            raise DataError(
+                f"the appraiser was fed {self.n_in} input(s) and {self.n_out} output(s); "
+                f"this chunk has {n_in} and {n_out}. Call reset() to start a new record."
+            )
+
+    def kernel_setup(self) -> kernel.KernelSetup:
+        """The kernel's plan and settings (fixed per record)."""
+        if self.setup is None:
+            assert self.n_in is not None and self.n_out is not None
+            channels = (self.n_in, self.n_out, self.mode() == "miso")
+            self.setup = kernel.record_setup(
+                self.settings, channels, self.n_params(), self.min_rows()
+            )
+        return self.setup
+
+    def trace_labels(self) -> TraceLabels:
+        """What the traces of this record say besides the numbers."""
+        if self.labels is not None:
+            return self.labels
+        n_in, n_out = self.n_in or 1, self.n_out or 1
+        names = self.names or (
+            tuple(f"u{i}" for i in range(n_in)) if n_in > 1 else ("u",),
+            tuple(f"y{i}" for i in range(n_out)) if n_out > 1 else ("y",),
+        )
+        st = self.settings
+        labels = TraceLabels(
+            structure=st.structure,
+            n_inputs=n_in,
+            mode=self.mode() if self.n_in is not None else "siso",
+            sample_time=self.time_step(),
+            names=names,
+            meta={"guard": st.guard, "method": st.method, "scaling": st.scaling},
+        )
+        if self.n_in is not None:
+            self.labels = labels
+        return labels
+
+    # ------------------------------------------------------------ the transition
+    def lag_rows(self, buf: np.ndarray) -> np.ndarray:
+        """Lag rows of every equation from decimated samples ``buf``: (E, n, p)."""
+        assert self.n_in is not None and self.n_out is not None
+        s = self.settings.structure
+        u, y = buf[:, : self.n_in], buf[:, self.n_in :]
+        if buf.shape[0] <= s.max_lag:
+            return np.empty((self.n_out, 0, self.n_params()))
+        miso = self.mode() == "miso"
+        return np.stack(
+            [miso_regressor(y[:, j], u if miso else u[:, j : j + 1], s) for j in range(self.n_out)]
+        )
+
+    def window(self) -> np.ndarray:
+        """The current window's lag vectors, shape (E, rows, p)."""
+        if self.buffer is None:
+            return np.empty((1, 0, self.settings.structure.n_params()))
+        rows_total = max(self.n_seen - self.max_lag, 0)
+        return self.lag_rows(self.buffer.since(max(rows_total - self.settings.window_size, 0)))
+
+    def updates_after(self, n_samples: int) -> int:
+        """Updates that ``n_samples`` more (undecimated) samples will complete."""
+        dec = self.decimator
+        f = dec.factor if dec is not None else 1
+        first = (-(dec.phase if dec is not None else 0)) % f  # the first one decimation keeps
+        kept = 0 if first >= n_samples else (n_samples - 1 - first) // f + 1
+        return max(self.n_seen + kept - self.max_lag, 0) // self.cluster - self.j_done
+
+    def keep_aside(self, sample: Any, update: bool, mapper: Callable[..., Any]) -> Trace:
+        """Keep one undecimated sample aside (fast ``step``); solve when it closes an update."""
+        buf = self.buffer
+        assert buf is not None
+        buf.pending.append(sample)
+        self.n_seen += 1
+        if not update:
+            return self.empty if self.empty is not None else self.empty_trace()
+        block = buf.take_pending()
+        self.n_seen -= block.shape[0]  # consume counts them
+        return self.consume(block, mapper)
+
+    def consume(self, new: np.ndarray, mapper: Callable[..., Any] = map) -> Trace:
+        """Append decimated samples and compute the updates they complete.
+
+        ``mapper`` is ``map`` or a thread pool's (``n_jobs > 1``: batches on threads).
+        """
+        if new.shape[0] == 0:
+            return self.empty_trace()
+        buf = self.buffer
+        assert buf is not None and self.last_theta is not None
+        assert self.last_c is not None and self.has_model is not None
+        buf.append(new)
+        self.n_seen += new.shape[0]
+        c, w, max_lag = self.cluster, self.settings.window_size, self.max_lag
+        j_last = max(self.n_seen - max_lag, 0) // c
+        trace = self.empty_trace()
+        if j_last > self.j_done:
+            state = kernel.FsmState(self.last_theta, self.last_c, self.has_model)
+            parts = kernel.solve_updates(
+                self.kernel_setup(),
+                (buf.data, buf.start - max_lag),
+                (self.j_done + 1, j_last),
+                state,
+                (self.settings.n_jobs, mapper),
+            )
+            labels = self.trace_labels()
+            traces = []
+            for j0, count, arrays in parts:
+                index = max_lag + c * np.arange(j0, j0 + count) - 1
+                traces.append(labels.trace(index, arrays.pop("n_rows"), arrays))
+            trace = traces[0] if len(traces) == 1 else Trace.concat(traces)
+            self.j_done = j_last
+        # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
+        buf.drop_before(max(0, c * (self.j_done + 1) - w - c))
+        return trace
+
+    def empty_trace(self) -> Trace:
+        """A trace without updates, shaped for the record's channels (cached once known)."""
+        if self.empty is not None:
+            return self.empty
+        s = self.settings.structure
+        p = self.n_params() if self.n_in is not None else s.n_params()
+        arrays = empty_arrays(self.n_out or 1, p, s, self.n_in or 1)
+        z = np.zeros(0, dtype=np.int64)
+        empty = self.trace_labels().trace(z, z, arrays)
+        if self.n_in is not None:
+            self.empty = empty
+        return empty
+
+    # ------------------------------------------------------------ the saved form
+    def to_dict(self) -> dict[str, Any]:
+        """The state as JSON-safe data (floats round-trip exactly), without the settings."""
+        buf, dec = self.buffer, self.decimator
+        if buf is not None:
+            buf.flush()
+        return {
+            "n_in": self.n_in,
+            "n_out": self.n_out,
+            "names": None if self.names is None else [list(n) for n in self.names],
+            "buf": _arr(np.empty((0, 0)) if buf is None else buf.data),
+            "buf_start": 0 if buf is None else buf.start,
+            "n_seen": self.n_seen,
+            "j_done": self.j_done,
+            "last_theta": _arr(self.last_theta),
+            "last_c": _arr(self.last_c),
+            "has_model": None if self.has_model is None else self.has_model.tolist(),
+            "factor": None if dec is None else dec.factor,
+            "dec_zi": None if dec is None else _arr(dec.zi),
+            "dec_phase": 0 if dec is None else dec.phase,
+            "record_dt": self.record_dt,
+        }
+
+    @classmethod
+    def from_dict(cls, settings: Settings, state: dict[str, Any]) -> AppraiserState:
+        """The state saved by :meth:`to_dict`, every field checked (:class:`StateError`)."""
+        new = cls(settings)
+        n_in, n_out = state.get("n_in"), state.get("n_out")
+        n_seen, j_done = field(state, "n_seen", int), field(state, "j_done", int)
+        if n_in is None or n_out is None:
+            if n_in is not None or n_out is not None or n_seen or j_done:
+                raise StateError("a state without channels (n_in, n_out) must have seen nothing.")
+            return new
+        n_in, n_out = field(state, "n_in", int), field(state, "n_out", int)
+        if n_in < 1 or n_out < 1:
+            raise StateError(f"n_in and n_out must be >= 1; got {n_in}, {n_out}.")
+        new.init_channels(n_in, n_out, checked_names(state.get("names"), n_in, n_out))
+        buf = checked_array(field(state, "buf", dict), "buf", (None, n_in + n_out))
+        start = field(state, "buf_start", int)
+        sizes = (new.max_lag, settings.window_size, settings.cluster_size)
+        validate_counters((n_seen, j_done, start, buf.shape[0]), sizes)
+        assert new.buffer is not None and new.last_theta is not None
+        if buf.size:
+            new.buffer.data = buf
+        new.buffer.start = start
+        new.n_seen, new.j_done = n_seen, j_done
+        p = new.last_theta.shape[1]
+        new.last_theta = checked_array(state.get("last_theta"), "last_theta", (n_out, p))
+        new.last_c = checked_array(state.get("last_c"), "last_c", (n_out,))
+        new.has_model = checked_flags(state.get("has_model"), new.last_theta)
+        if state.get("factor") is not None:
+            new.set_decimator(
+                Decimator(*checked_decimator(state, n_in + n_out, settings.decimate_to))
+            )
+        record_dt = state.get("record_dt")
+        if record_dt is not None:
+            new.record_dt = check_positive(record_dt, "state['record_dt']", "s")
+        return new
 
 
 def _arr(x: np.ndarray | None) -> Any:
     return None if x is None else {"shape": list(x.shape), "data": x.ravel().tolist()}
-
-
-def config_of(a: Any) -> dict[str, Any]:
-    """The constructor arguments of appraiser ``a`` (JSON-safe)."""
-    return {
-        "parameters_size": a.parameters_size,
-        "window_size": a.window_size,
-        "cluster_size": a.cluster_size,
-        **({"sample_time": a.sample_time} if a._legacy_sample_time else {}),
-        **({} if a._legacy_sample_time else {"decimate_to": a.sample_time}),
-        "na": a.structure.na,
-        "nb": a.structure.nb,
-        "nk": a.structure.nk,
-        "method": a.method,
-        "scaling": a.scaling,
-        "mimo": a.mimo,
-        "noise_ratio": a.noise_ratio,
-        "noise_cov": None if a.noise_cov is None else a.noise_cov.tolist(),
-        "rule": asdict(a.rule),
-        "guard": a.guard,
-        "trust_rows": a.trust_rows,
-        "min_rows": a.min_rows,
-        "dt": a.data_sample_time,
-        "n_jobs": a.n_jobs,
-        "chunk_samples": a.chunk_samples,
-    }
-
-
-def digest(state: dict[str, Any]) -> str:
-    """SHA-256 of a state's content (every field but ``digest``), canonical JSON."""
-    body = {k: v for k, v in state.items() if k != "digest"}
-    text = json.dumps(body, sort_keys=True, separators=(",", ":"), allow_nan=True)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def _check_digest(state: dict[str, Any]) -> None:
-    """The state is the one saved: any edit that passed the schema would change results."""
-    stored = field(state, "digest", str)
-    try:
-        fresh = digest(state)
-    except (TypeError, ValueError) as exc:
-        raise StateError(f"the state holds values JSON cannot hold: {exc}") from None
-    if stored != fresh:
-        raise StateError(
-            "state['digest'] does not match the state's content: the state was edited or "
-            "damaged after it was saved (an edited sample, counter or setting would change "
-            "the results without a word); save it again from the appraiser."
-        )
-
-
-def snapshot(a: Any) -> dict[str, Any]:
-    """The state of appraiser ``a`` (see :meth:`clpc.CLPC.state_dict`)."""
-    buf = a._buffer
-    if buf is not None:
-        buf.flush()
-    dec = a._decimator
-    out: dict[str, Any] = {
-        "format": FORMAT,
-        "version": VERSION,
-        "config": config_of(a),
-        "n_in": a._n_in,
-        "n_out": a._n_out,
-        "names": None if a._names is None else [list(n) for n in a._names],
-        "buf": _arr(np.empty((0, 0)) if buf is None else buf.data),
-        "buf_start": 0 if buf is None else buf.start,
-        "n_seen": a._n_seen,
-        "j_done": a._j_done,
-        "last_theta": _arr(a._last_theta),
-        "last_c": _arr(a._last_c),
-        "has_model": None if a._has_model is None else a._has_model.tolist(),
-        "factor": None if dec is None else dec.factor,
-        "dec_zi": None if dec is None else _arr(dec.zi),
-        "dec_phase": 0 if dec is None else dec.phase,
-        "record_dt": a._record_dt,
-    }
-    out["digest"] = digest(out)
-    return out
-
-
-def restore(cls: Any, state: Any) -> Any:
-    """An appraiser of class ``cls`` that continues exactly where ``state`` left off.
-
-    Every field is checked first (:mod:`clpc.appraiser.state_schema`); a damaged or edited
-    state raises :class:`~clpc.appraiser.state_schema.StateError` naming the field.
-    """
-    try:
-        return _restore(cls, state)
-    except StateError:
-        raise
-    except (TypeError, ValueError, KeyError, OverflowError, RecursionError) as exc:
-        raise StateError(f"the state does not describe an appraiser: {exc}") from None
-    except MemoryError:
-        raise StateError(
-            "the state's settings (state['config']: window_size, parameters) need more memory "
-            "than is available; it is not a state this machine saved."
-        ) from None
-
-
-def _restore(cls: Any, state: Any) -> Any:
-    if not isinstance(state, dict):
-        raise StateError(f"a state must be a JSON object; got {type(state).__name__}.")
-    if state.get("format") != FORMAT or state.get("version") != VERSION:
-        raise StateError("not a clpc appraiser state (format/version mismatch).")
-    a = _configured(cls, field(state, "config", dict))
-    n_in, n_out = state.get("n_in"), state.get("n_out")
-    n_seen, j_done = field(state, "n_seen", int), field(state, "j_done", int)
-    if n_in is None or n_out is None:
-        if n_in is not None or n_out is not None or n_seen or j_done:
-            raise StateError("a state without channels (n_in, n_out) must have seen nothing.")
-        _check_digest(state)
-        return a
-    n_in, n_out = field(state, "n_in", int), field(state, "n_out", int)
-    if n_in < 1 or n_out < 1:
-        raise StateError(f"n_in and n_out must be >= 1; got {n_in}, {n_out}.")
-    fsm.init_channels(a, n_in, n_out, _names(state.get("names"), n_in, n_out))
-    buf = checked_array(field(state, "buf", dict), "buf", (None, n_in + n_out))
-    start = field(state, "buf_start", int)
-    sizes = (a.structure.max_lag, a.window_size, a.cluster_size)
-    validate_counters((n_seen, j_done, start, buf.shape[0]), sizes)
-    assert a._buffer is not None
-    if buf.size:
-        a._buffer.data = buf
-    a._buffer.start = start
-    a._n_seen, a._j_done = n_seen, j_done
-    p = a._last_theta.shape[1]
-    a._last_theta = checked_array(state.get("last_theta"), "last_theta", (n_out, p))
-    a._last_c = checked_array(state.get("last_c"), "last_c", (n_out,))
-    hm = state.get("has_model")
-    if not isinstance(hm, list) or len(hm) != n_out or not all(isinstance(x, bool) for x in hm):
-        raise StateError(f"state['has_model'] must be {n_out} booleans; got {hm!r:.60}.")
-    a._has_model = np.asarray(hm, dtype=bool)
-    if np.any(a._has_model & ~(np.abs(a._last_theta[:, 0]) > 0)):
-        raise StateError("state['last_theta'] has a0 = 0 for an output with a model.")
-    _restore_decimator(a, state, n_in + n_out)
-    record_dt = state.get("record_dt")
-    if record_dt is not None:
-        a._record_dt = check_positive(record_dt, "state['record_dt']", "s")
-    _check_digest(state)
-    return a
-
-
-def _configured(cls: Any, config: dict[str, Any]) -> Any:
-    """A new appraiser from the saved constructor arguments (checked by the constructor)."""
-    cfg = dict(config)
-    size = cfg.pop("parameters_size", None)
-    if "gate" in cfg:  # states written before the guard was renamed
-        cfg["guard"] = cfg.pop("gate")
-    cfg.pop("engine", None)  # states written while the kernel had an engine setting
-    rule = cfg.pop("rule", None)
-    if not isinstance(rule, dict):
-        raise StateError("state['config']['rule'] must be an object of thresholds.")
-    try:
-        return cls(size, rule=RobustRule(**rule), **cfg)
-    except (TypeError, ValueError) as exc:
-        raise StateError(f"state['config'] does not describe an appraiser: {exc}") from None
-
-
-def _names(names: Any, n_in: int, n_out: int) -> tuple[tuple[str, ...], ...] | None:
-    if names is None:
-        return None
-    ok = (
-        isinstance(names, list)
-        and len(names) == 2
-        and all(isinstance(g, list) and all(isinstance(n, str) for n in g) for g in names)
-        and (len(names[0]), len(names[1])) == (n_in, n_out)
-    )
-    if not ok:
-        raise StateError(f"state['names'] must be [{n_in} input names, {n_out} output names].")
-    return tuple(names[0]), tuple(names[1])
-
-
-def _restore_decimator(a: Any, state: dict[str, Any], channels: int) -> None:
-    factor = state.get("factor")
-    if factor is None:
-        return
-    factor = field(state, "factor", int)
-    if factor < 1 or (factor > 1 and a.sample_time is None):
-        raise StateError(
-            f"state['factor']={factor}: decimation needs factor >= 1, and a factor above 1 "
-            "needs a sample_time to decimate to."
-        )
-    a._decimator = Decimator(factor)
-    if factor > 1 and state.get("dec_zi") is not None:
-        a._decimator.zi = checked_array(state["dec_zi"], "dec_zi", (2, 2, channels))
-    phase = field(state, "dec_phase", int)
-    if not 0 <= phase < factor:
-        raise StateError(f"state['dec_phase'] must be in [0, {factor}); got {phase}.")
-    a._decimator.phase = phase
-
-
-def save(a: Any, path: str) -> None:
-    """Write the state of ``a`` as JSON to ``path``."""
-    with open(path, "w", encoding="utf-8") as fh:
-        json.dump(snapshot(a), fh)
-
-
-def load(cls: Any, path: str) -> Any:
-    """Read an appraiser saved with :func:`save`."""
-    with open(path, encoding="utf-8") as fh:
-        text = fh.read(MAX_STATE_BYTES + 1)
-    return restore(cls, parse_json(text))

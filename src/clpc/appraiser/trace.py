@@ -1,4 +1,8 @@
-"""The output of the appraiser: one row per cluster update, plus the convergence verdict."""
+"""The output of the appraiser: one row per cluster update, plus the convergence verdict.
+
+:class:`TraceLabels` is what a trace says about its appraiser besides the numbers;
+:func:`empty_arrays` the arrays of a trace without updates.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +17,7 @@ from clpc.appraiser.convergence import steady_state_model as steady_state
 from clpc.model import LinearModel
 from clpc.model.structure import Structure
 
-__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "Trace"]
+__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "Trace", "TraceLabels", "empty_arrays"]
 
 # per-update scalar statistics of each equation: shape (n_updates, n_equations)
 SCALAR_KEYS = (
@@ -64,6 +68,18 @@ class Trace:
         ``lambda_min``, ``lambda_max``, ``D``, ``eig_ratio``, ``separation``,
         ``noise_variance``, ``J``, ``c``, ``n_null``, ``n_input_relations`` and flags
         ``degenerate``, ``determined``, ``accepted``, ``has_model``, ``stable``.
+    structure : Structure
+        Orders and delay of every window's model.
+    n_inputs : int
+        Inputs of the record.
+    mode : {"siso", "paired", "miso"}
+        How outputs relate to inputs.
+    sample_time : float
+        The appraiser's sample time [s] (after decimation).
+    input_names, output_names : tuple of str
+        Channel names.
+    meta : dict
+        The appraiser's settings and what it noticed (JSON-safe; written beside trace files).
     """
 
     index: np.ndarray
@@ -103,7 +119,25 @@ class Trace:
     # ----------------------------------------------------------------- building
     @classmethod
     def concat(cls, traces: list[Trace], like: Trace | None = None) -> Trace:
-        """Concatenate traces of the same appraiser in time order."""
+        """Concatenate traces of the same appraiser in time order.
+
+        Parameters
+        ----------
+        traces : list of Trace
+            Parts in time order (``None`` entries are skipped).
+        like : Trace, optional
+            The trace whose settings (structure, names, ``meta``) the result takes; default
+            the first part.
+
+        Returns
+        -------
+        Trace
+
+        Raises
+        ------
+        ValueError
+            No trace to concatenate.
+        """
         traces = [t for t in traces if t is not None]
         if not traces:
             raise ValueError("nothing to concatenate")
@@ -124,6 +158,13 @@ class Trace:
 
         Lets a long run write its parts into the final arrays instead of concatenating them
         at the end (which holds the parts and the result at once: twice the memory).
+
+        Parameters
+        ----------
+        like : Trace
+            A trace of the same appraiser (its settings, names and array shapes per row).
+        n : int
+            Rows to allocate.
         """
         plain = ("index", "time", "rows", "not_enough_data")
         kw: dict[str, Any] = {
@@ -138,7 +179,20 @@ class Trace:
         return cls(**kw, arrays=arrays, **rest)
 
     def put(self, start: int, part: Trace) -> int:
-        """Copy the rows of ``part`` into rows ``start ..``; returns the row after them."""
+        """Copy the rows of ``part`` into rows ``start ..``; returns the row after them.
+
+        Parameters
+        ----------
+        start : int
+            First row to write.
+        part : Trace
+            Rows of the same appraiser (from :meth:`CLPC.push`).
+
+        Returns
+        -------
+        int
+            ``start + len(part)``.
+        """
         stop = start + len(part)
         for f in ("index", "time", "rows", "not_enough_data"):
             getattr(self, f)[start:stop] = getattr(part, f)
@@ -179,6 +233,11 @@ class Trace:
     def held(self, n_samples: int) -> np.ndarray:
         """Held output parameters at every sample ``k = 0 .. n_samples - 1``.
 
+        Parameters
+        ----------
+        n_samples : int
+            Samples of the (decimated) record.
+
         Returns
         -------
         ndarray, shape (n_samples, n_equations, p)
@@ -203,6 +262,15 @@ class Trace:
         (relative) since the previous update; convergence needs ``consecutive`` such
         updates in a row, and at least :data:`MIN_TRUSTED_FRACTION` of the windows trusted
         (:func:`clpc.appraiser.convergence.convergence`).
+
+        Parameters
+        ----------
+        theta_tol : float
+            Largest move of ``theta`` between updates (Euclidean, unit vectors).
+        D_tol : float
+            Largest relative move of ``D`` between updates.
+        consecutive : int
+            Quasi-constant updates in a row that make convergence.
         """
         return convergence.convergence(self, theta_tol, D_tol, consecutive)
 
@@ -224,3 +292,54 @@ class Trace:
             With ``info["convergence"]``.
         """
         return steady_state(self, convergence, allow_unconverged=allow_unconverged)
+
+
+@dataclass(frozen=True)
+class TraceLabels:
+    """What a trace says about its appraiser besides the numbers."""
+
+    structure: Structure
+    n_inputs: int
+    mode: str
+    sample_time: float
+    names: tuple[tuple[str, ...], tuple[str, ...]]
+    meta: dict[str, Any]
+
+    def trace(self, index: np.ndarray, rows: np.ndarray, arrays: dict[str, np.ndarray]) -> Trace:
+        """A trace of updates ending at samples ``index`` with ``rows`` lag vectors each."""
+        return Trace(
+            index=np.asarray(index, dtype=np.int64),
+            time=np.asarray(index, dtype=np.float64) * self.sample_time,
+            rows=np.asarray(rows, dtype=np.int64),
+            not_enough_data=arrays.pop("not_enough"),
+            arrays=arrays,
+            structure=self.structure,
+            n_inputs=self.n_inputs,
+            mode=self.mode,
+            sample_time=self.sample_time,
+            input_names=self.names[0],
+            output_names=self.names[1],
+            meta=dict(self.meta),
+        )
+
+
+def empty_arrays(
+    n_equations: int, p: int, structure: Structure, n_inputs: int
+) -> dict[str, np.ndarray]:
+    """Zero-row per-equation arrays of the right shapes and types (an empty trace)."""
+    s = structure
+    shapes = {
+        "theta": (p,),
+        "theta_estimate": (p,),
+        "den": (s.na + 1,),
+        "num": (n_inputs, s.nk + s.nb + 1),
+        "eigenvalues": (p,),
+    }
+    ints = ("n_null", "n_input_relations")
+    bools = ("degenerate", "determined", "excited", "trusted", "accepted", "has_model", "stable")
+    arrays: dict[str, np.ndarray] = {}
+    for key in PER_EQUATION:
+        dtype = np.int64 if key in ints else (np.bool_ if key in bools else np.float64)
+        arrays[key] = np.zeros((0, n_equations, *shapes.get(key, ())), dtype=dtype)
+    arrays["not_enough"] = np.zeros(0, dtype=np.bool_)
+    return arrays

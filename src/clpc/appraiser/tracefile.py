@@ -72,6 +72,17 @@ def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
     ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
     the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
     flags are 0/1.
+
+    Parameters
+    ----------
+    trace : Trace
+        A CLPC trace.
+
+    Returns
+    -------
+    names : list of str
+        Column names.
+    table : ndarray, shape (n_updates, n_columns)
     """
     names, cols = trace_column_list(trace)
     table = (
@@ -159,11 +170,9 @@ class TraceWriter:
                 formats = ["%d" if _is_integer(c) else "%r" for c in cols]
                 self._row_format = ",".join(formats) + "\n"
             return
-        try:
-            import pyarrow as pa
-            import pyarrow.parquet as pq
-        except ImportError:
-            raise ImportError("Parquet traces need pyarrow: pip install 'clpc[frames]'") from None
+        import pyarrow as pa  # a dependency of clpc, imported when a Parquet trace is written
+        import pyarrow.parquet as pq
+
         self._pa = pa
         schema = pa.schema(
             [

@@ -9,7 +9,7 @@ has the same colour in every figure (:data:`clpc.core.figure.COLORS`); records l
 :data:`clpc.core.figure.MAX_POINTS` samples are drawn as min/max envelopes.
 
 >>> import clpc, clpc.datasets as ds                                  # doctest: +SKIP
->>> trace = clpc.CLPC(3, 201, 12).run(ds.load("dryer"))               # doctest: +SKIP
+>>> trace = clpc.CLPC(order=2).run(ds.load("dryer"))                  # doctest: +SKIP
 >>> fig = clpc.plotting.plot_trace(trace, "trace.png")                # doctest: +SKIP
 """
 

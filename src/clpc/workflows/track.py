@@ -285,8 +285,8 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                 data_dt = clock.dt if clock is not None else record.dt
                 kept = ThinnedTrace(settings.figure_updates)
                 appraiser = settings.appraiser.build(data_dt)
-                rate = data_dt if data_dt is not None else appraiser.data_sample_time
-                factor = decimation_factor(appraiser.sample_time, rate)
+                rate = data_dt if data_dt is not None else appraiser.dt
+                factor = decimation_factor(appraiser.decimate_to, rate)
                 run = _Run(appraiser, kept, 0, _Tail(factor))
             run.n_raw += values.shape[0]
             run.tail.feed(values[:, : n_in + n_out])

@@ -40,9 +40,9 @@ def appraise(u: Any, y: Any, dt: float, method: str) -> Identification:
     result are the signals given (not decimated).
     """
     appraiser = CLPC(
-        PARAMETERS_SIZE,
-        WINDOW_SIZE,
-        CLUSTER_SIZE,
+        order=PARAMETERS_SIZE - 1,
+        window_size=WINDOW_SIZE,
+        cluster_size=CLUSTER_SIZE,
         decimate_to=SAMPLE_TIME,
         method=method,
         guard=GUARD,

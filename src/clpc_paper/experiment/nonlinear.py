@@ -65,7 +65,7 @@ def _held(trace: Any, n: int, lag: int) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 def _causal_scores(u: np.ndarray, y: np.ndarray, start: int) -> tuple[float, float]:
     """Free-run and 10-step fits of CLPC causal on a validation record (from ``start``)."""
-    trace = CLPC(ORDER + 1, 201, 12).run(u, y, dt=0.01)
+    trace = CLPC(order=ORDER, window_size=201, cluster_size=12).run(u, y, dt=0.01)
     n = y.size
     den, num, icpt, _ = _held(trace, n, 1)
     sim = simulate_time_varying(
@@ -108,7 +108,7 @@ def _one_plant(name: str, params: CrankParameters, seeds: list[Any], quick: bool
         ),
     }
     u, y = ident.command, ident.position
-    trace = CLPC(ORDER + 1, 201, 12).run(u, y, dt=0.01)
+    trace = CLPC(order=ORDER, window_size=201, cluster_size=12).run(u, y, dt=0.01)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         steady = trace.steady_state_model(allow_unconverged=True)
