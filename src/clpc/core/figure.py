@@ -57,14 +57,35 @@ COLORS: dict[str, str] = {
 MAX_POINTS = 4000
 
 
-def new_figure(n_rows: int = 1, n_cols: int = 1, *, height: float = 2.6, width: float = 8.0):
+#: margins of :func:`new_figure` [in]: room for tick labels of up to about seven characters,
+#: an axis label on the left and below, a title above each axes and the figure's title
+
+
+def new_figure(
+    n_rows: int = 1,
+    n_cols: int = 1,
+    *,
+    height: float = 2.6,
+    width: float = 8.0,
+    fixed: bool = False,
+):
     """A new Agg-backed figure (no pyplot state) and its axes, shape (n_rows, n_cols).
 
-    ``height`` per row and ``width`` in inches (0.7 in more for the title); matplotlib's
-    constrained layout places the axes.
+    ``height`` per row and ``width`` in inches (0.7 in more for the title). ``fixed``: the
+    axes are placed by the fixed :data:`PLOT_MARGINS` (for stacked axes with one title and
+    a legend row above each: matplotlib's constrained layout measures every tick label,
+    about a third of such a figure's drawing time); otherwise constrained layout places
+    them (labels of unknown size, legends beside the axes, multi-line titles).
     """
-    fig = _figure((width, 0.7 + height * n_rows), constrained=True)
-    return fig, fig.subplots(n_rows, n_cols, squeeze=False)
+    if not fixed:
+        fig = _figure((width, 0.7 + height * n_rows), constrained=True)
+        return fig, fig.subplots(n_rows, n_cols, squeeze=False)
+    fig, grid = new_grid(n_rows, n_cols, PLOT_MARGINS, height=height, width=width)
+    axes = np.empty((n_rows, n_cols), dtype=object)
+    for i in range(n_rows):
+        for j in range(n_cols):
+            axes[i, j] = fig.add_subplot(grid[i, j])
+    return fig, axes
 
 
 def new_grid(n_rows: int, n_cols: int, margins: Margins, *, height: float, width: float = 8.0):
@@ -115,7 +136,14 @@ class Margins:
         }
 
 
-def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tuple[Any, list]:
+#: margins of :func:`new_figure` [in]: room for tick labels of up to about seven characters,
+#: an axis label on the left and below, a title above each axes and the figure's title
+PLOT_MARGINS = Margins(left=1.0, right=0.3, top=0.75, bottom=0.6, row_gap=0.75, col_gap=1.0)
+
+
+def axes_for(
+    ax: Any, n: int, *, height: float = 2.6, width: float = 8.0, fixed: bool = False
+) -> tuple[Any, list]:
     """The figure and ``n`` axes to draw on: new ones, or the caller's ``ax``.
 
     Parameters
@@ -125,6 +153,10 @@ def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tup
         single Axes when ``n == 1``).
     n : int
         Panels the plot needs.
+    height, width : float
+        Size of each new panel [in].
+    fixed : bool
+        New axes placed by fixed margins (see :func:`new_figure`).
 
     Raises
     ------
@@ -132,7 +164,7 @@ def axes_for(ax: Any, n: int, *, height: float = 2.6, width: float = 8.0) -> tup
         ``ax`` does not hold ``n`` axes.
     """
     if ax is None:
-        fig, axes = new_figure(n, 1, height=height, width=width)
+        fig, axes = new_figure(n, 1, height=height, width=width, fixed=fixed)
         return fig, list(axes[:, 0])
     axes = (
         list(np.ravel(np.asarray(ax, dtype=object)))

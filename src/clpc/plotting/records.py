@@ -16,8 +16,14 @@ __all__ = ["plot_compare", "plot_data", "plot_fit"]
 plot_data = plot_iodata
 
 
+#: below this fit % a model is said to diverge (its number has no meaning then: -1e140 %)
+DIVERGED_FIT = -1000.0
+
+
 def _fit_text(fit: float) -> str:
-    return "n/a: diverges" if not np.isfinite(fit) else f"{fit:.1f} %"
+    if not np.isfinite(fit) or fit < DIVERGED_FIT:
+        return "n/a: diverges"
+    return f"{fit:.1f} %"
 
 
 def _keep_to_measured(ax_y: Any, ax_r: Any, meas: np.ndarray, modelled: np.ndarray) -> None:
@@ -91,7 +97,7 @@ def plot_compare(
         fits = np.repeat(fits, ya.shape[1])
     n_out = ya.shape[1]
     names = list(names) if names is not None else [f"y{j}" for j in range(n_out)]
-    fig, axes = axes_for(ax, n_out, height=2.6)
+    fig, axes = axes_for(ax, n_out, height=2.6, fixed=True)
     color = COLORS["prediction" if "predict" in label else "model"]
     for j in range(n_out):
         a = axes[j]
@@ -145,7 +151,7 @@ def plot_fit(
 
     y_hat, start, fit = model_response(model, data.u, data.y, k)
     what = "simulation" if k is None else f"{k}-step prediction"
-    fig, axes = axes_for(ax, 2 * data.n_outputs, height=1.9)
+    fig, axes = axes_for(ax, 2 * data.n_outputs, height=1.9, fixed=True)
     t = t0 + data.time[start:]
     color = COLORS["model" if k is None else "prediction"]
     for j, name in enumerate(data.output_names):

@@ -74,7 +74,7 @@ def plot_bode(
     -------
     matplotlib.figure.Figure
     """
-    fig, (ax_m, ax_p) = axes_for(ax, 2, height=2.6)
+    fig, (ax_m, ax_p) = axes_for(ax, 2, height=2.6, fixed=True)
     freqs = bode_frequencies(model, n_freqs)
     for k, (j, i, label) in enumerate(_channels(model)):
         f, h = model.frequency_response(freqs, output=j, input=i)
@@ -93,7 +93,7 @@ def plot_bode(
               ha="right", va="bottom", fontsize="small", color=COLORS["nyquist"])  # fmt: skip
     ax_m.set_ylabel("magnitude [dB]")
     ax_p.set_ylabel("phase [deg]")
-    place_legend(ax_m, outside=True)
+    place_legend(ax_m)
     fig.suptitle(title or "Bode plot")
     save_figure(fig, path)
     return fig
@@ -135,7 +135,7 @@ def plot_step(
     matplotlib.figure.Figure
         The static gain ``G(1)`` of each channel is drawn dashed (when finite).
     """
-    fig, (axs,) = axes_for(ax, 1, height=3.0)
+    fig, (axs,) = axes_for(ax, 1, height=3.0, fixed=True)
     n = n_samples or step_samples(model)
     t = np.arange(n) * model.dt
     gains = model.dc_gain()
@@ -150,7 +150,7 @@ def plot_step(
     axs.set_xlabel(time_label(model.dt))
     axs.set_ylabel("output per unit input [-]")
     axs.grid(True, alpha=0.3)
-    place_legend(axs, outside=True)
+    place_legend(axs)
     fig.suptitle(title or "step response (dotted: static gain)")
     save_figure(fig, path)
     return fig
