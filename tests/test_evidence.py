@@ -135,3 +135,20 @@ def test_regressors_equal_the_paper_lag_matrix(record):
     want = siso_regressor(record.y[:, 0], record.u[:, 0], structure)
     np.testing.assert_array_equal(got[0], want)
     assert got[0].flags.f_contiguous
+
+
+def test_evidence_whose_computation_fails_stays_pending(record):
+    model = clpc.LPC(order=2).fit(record)
+    calls = []
+
+    def flaky(fitted):
+        calls.append(1)
+        if len(calls) == 1:
+            raise KeyboardInterrupt  # e.g. the user stops a slow jackknife
+        return {"covariance_note": "computed on the second read"}
+
+    info = FitInfo({}, model, model.record.with_producer("covariance", flaky))
+    with pytest.raises(KeyboardInterrupt):
+        info["covariance_note"]
+    assert "covariance" in info.pending
+    assert info["covariance_note"] == "computed on the second read" and calls == [1, 1]

@@ -110,8 +110,8 @@ class FitInfo(dict[str, Any]):
         return None
 
     def _produce(self, kind: str) -> None:
-        producer = self._pending.pop(kind)
-        entries = producer(self._model)
+        entries = self._pending[kind](self._model)  # a producer that raises stays pending
+        del self._pending[kind]
         if self._model.n_outputs == 1:  # as the model's own statistics (LinearModel)
             entries = squeeze_info(entries)
         self.update(entries)
