@@ -109,7 +109,9 @@ def siso_regressor(y: np.ndarray, u: np.ndarray, structure: Structure) -> np.nda
 #   M =  |  ...                |  ...                      |     |  ...                      |
 #
 # theta = [a; b_1; ...; b_m] and a(q) y_j + sum_i b_i(q) u_i = r.
-def miso_regressor(y: np.ndarray, u: np.ndarray, structure: Structure) -> np.ndarray:
+def miso_regressor(
+    y: np.ndarray, u: np.ndarray, structure: Structure, out: np.ndarray | None = None
+) -> np.ndarray:
     """Lag matrix of one output on its own past and on every input.
 
     Parameters
@@ -120,16 +122,23 @@ def miso_regressor(y: np.ndarray, u: np.ndarray, structure: Structure) -> np.nda
         All inputs.
     structure : Structure
         Orders and delay (shared by every input).
+    out : ndarray, shape (T - max_lag, na + 1 + m (nb + 1)), optional
+        Where to write the matrix (any memory order); default a new C-contiguous array.
 
     Returns
     -------
     ndarray, shape (T - max_lag, na + 1 + m (nb + 1))
-        A new C-contiguous array.
+        ``out``, or the new array.
     """
-    start = structure.max_lag
-    blocks = [lagged(y, structure.na, 0, start)]
-    blocks += [lagged(u[:, i], structure.nb, structure.nk, start) for i in range(u.shape[1])]
-    return np.concatenate(blocks, axis=1)
+    start, na1, nb1 = structure.max_lag, structure.na + 1, structure.nb + 1
+    if out is None:
+        out = np.empty((y.shape[0] - start, na1 + u.shape[1] * nb1))
+    out[:, :na1] = lagged(y, structure.na, 0, start)
+    for i in range(u.shape[1]):
+        out[:, na1 + i * nb1 : na1 + (i + 1) * nb1] = lagged(
+            u[:, i], structure.nb, structure.nk, start
+        )
+    return out
 
 
 # The paper's paired MIMO (eqs. 35-38): q separate SISO systems, output j driven by input j
@@ -160,21 +169,20 @@ def regressors(data: IOData, structure: Structure, mode: MimoMode) -> np.ndarray
         boundary).
     """
     check_mode(mode, data.n_inputs, data.n_outputs)
-    if data.n_experiments > 1:
-        return np.concatenate([regressors(part, structure, mode) for part in data.split()], axis=1)
-    data.require_samples(
-        structure.max_lag + 2,
-        f"A model with na={structure.na}, nb={structure.nb}, nk={structure.nk}",
-    )
-    start, n_out, n_rows = structure.max_lag, data.n_outputs, data.n_samples - structure.max_lag
-    n_in = input_blocks(mode, data.n_inputs)
-    na1, nb1 = structure.na + 1, structure.nb + 1
-    # each out[j] column-major (Fortran order): a column is one contiguous copy of a signal
-    out = np.empty((n_out, na1 + n_in * nb1, n_rows)).transpose(0, 2, 1)
-    for j in range(n_out):
-        columns = [(data.y[:, j], lag) for lag in range(na1)]
-        inputs = range(n_in) if mode == "miso" else (j,)  # siso and paired: input j
-        columns += [(data.u[:, i], structure.nk + lag) for i in inputs for lag in range(nb1)]
-        for col, (signal, lag) in enumerate(columns):
-            out[j, :, col] = signal[start - lag : start - lag + n_rows]  # x(n - lag)
+    parts = data.split() if data.n_experiments > 1 else [data]
+    for part in parts:
+        part.require_samples(
+            structure.max_lag + 2,
+            f"A model with na={structure.na}, nb={structure.nb}, nk={structure.nk}",
+        )
+    rows = [part.n_samples - structure.max_lag for part in parts]
+    p = structure.n_params(input_blocks(mode, data.n_inputs))
+    # each out[j] column-major (Fortran order): a column is one contiguous run of a signal
+    out = np.empty((data.n_outputs, p, sum(rows))).transpose(0, 2, 1)
+    first = 0
+    for part, n_rows in zip(parts, rows, strict=True):
+        for j in range(data.n_outputs):
+            inputs = part.u if mode == "miso" else part.u[:, j : j + 1]  # siso, paired: input j
+            miso_regressor(part.y[:, j], inputs, structure, out[j, first : first + n_rows])
+        first += n_rows
     return out
