@@ -77,7 +77,8 @@ def test_datasets_lists_paths():
 
 # ================================================================= identify
 def test_identify_text_on_shipped_record():
-    out = ok("identify", DRYER, "--input", "u", "--output", "y", "--dt", "0.08").output
+    args = ("--estimator", "lpc", "--order", "2", "--nk", "0")
+    out = ok("identify", DRYER, "--input", "u", "--output", "y", "--dt", "0.08", *args).output
     for word in (
         "A(z) = 1 -",
         "poles:",
@@ -92,7 +93,8 @@ def test_identify_text_on_shipped_record():
 
 
 def test_identify_json_matches_library():
-    res = ok("identify", DRYER, "-u", "u", "-y", "y", "--order", "3", "--json", "--dt", "0.08")
+    args = ("--estimator", "lpc", "--order", "3", "--nk", "0", "--json", "--dt", "0.08")
+    res = ok("identify", DRYER, "-u", "u", "-y", "y", *args)
     s = json.loads(res.stdout)
     data = ds.load("dryer")
     model = clpc.LPC(order=3).fit(data)
@@ -117,6 +119,10 @@ def test_identify_auto_order(record):
             "u",
             "-y",
             "y",
+            "--estimator",
+            "lpc",
+            "--nk",
+            "0",
             "--order",
             "auto",
             "--max-order",
@@ -133,9 +139,11 @@ def test_identify_auto_order(record):
     assert s["order_selection"]["orders"] == [1, 2, 3, 4]
     assert s["order_selection"]["criterion"] == "validation"
     assert s["dt"] == pytest.approx(0.01)
-    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto").output
+    lpc = ("--estimator", "lpc", "--nk", "0")
+    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto", *lpc).output
     assert "order selection (held-out score: mean of free-run and" in out
-    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto", "--criterion", "bic").output
+    bic = ("--criterion", "bic")
+    out = ok("identify", path, "-u", "u", "-y", "y", "-n", "auto", *bic, *lpc).output
     assert "order selection (BIC, lower is better)" in out
 
 
@@ -164,7 +172,8 @@ def test_identify_mimo_and_column_indices():
 def test_save_simulate_compare_round_trip(record, tmp_path):
     path, u, y, dt = record
     model_file = tmp_path / "m.json"
-    out = ok("identify", path, "-u", "u", "-y", "y", "--dt", dt, "--save", model_file).output
+    lpc = ("--estimator", "lpc", "--order", "2", "--nk", "0")
+    out = ok("identify", path, "-u", "u", "-y", "y", "--dt", dt, "--save", model_file, *lpc).output
     assert f"model saved to {model_file}" in out
     model = clpc.LPC(order=2).fit(u, y, dt)
     loaded = load_model(model_file)
@@ -534,7 +543,10 @@ def test_workflows_without_the_command_line(record, tmp_path):
     path, u, _, dt = record
     rec = wf.RecordSpec(path, ("u",), ("y",), time_col="t")
     model_file = str(tmp_path / "m.json")
-    res = wf.identify_file(wf.IdentifySettings(rec, order="auto", max_order=3, save=model_file))
+    settings = wf.IdentifySettings(
+        rec, estimator="lpc", nk=0, order="auto", max_order=3, save=model_file
+    )
+    res = wf.identify_file(settings)
     assert res.selection is not None and res.summary["saved"] == model_file
     assert len(res.scores()) == 3 and res.summary["dt"] == pytest.approx(dt)
     cmp = wf.compare_file(wf.CompareSettings(model_file, wf.RecordSpec(path, time_col="t"), k=1))

@@ -184,7 +184,7 @@ def _two_outputs(seed: int) -> clpc.IOData:
 
 def test_identify_mix_keeps_covariance_noise_model_and_evidence():
     data = _two_outputs(6)
-    model = comparison.final_model(data, ("arx", "oe"), 1, 0, None)
+    model = comparison.final_model(data, ("arx", "oe"), clpc.Structure(1, 1, 0), None)
     arx = clpc.ARX(order=1, assess=False).fit(data)
     oe = clpc.OE(order=1, assess=False).fit(data)
     assert model.info["noise_model"] == ["equation-error", "output-error"]
@@ -211,7 +211,8 @@ def test_identify_returns_the_model_with_its_evidence():
     model = result.model
     assert model.info["noise_model"] == "output-error"
     lo, hi = model.confidence_interval()
-    assert lo.shape == (5,) and np.all(lo < hi)
+    s = result.structure
+    assert lo.shape == (s.na + s.nb + 1,) and np.all(lo < hi)  # a1..a_na, b0..b_nb
     assert "free_run" in model.info["heldout"]
 
 
@@ -256,12 +257,12 @@ def test_rank_deficient_fits_keep_the_model_and_say_why_there_is_no_covariance()
 
 
 def test_cli_names_the_estimator_in_the_summary_and_the_report(tmp_path):
-    args = ["identify", str(ds.path("dryer")), "-u", "u", "-y", "y", "--nk", "3"]
+    args = ["identify", str(ds.path("dryer")), "-u", "u", "-y", "y", "--nk", "3", "--order", "2"]
     res = CliRunner().invoke(cli, [*args, "--estimator", "oe", "--report", str(tmp_path / "r")])
     assert res.exit_code == 0, res.output
     assert "\nOE (output error) model  na=2 nb=2 nk=3  method=output-error" in res.output
     assert "parameters (+- 1 sigma): a1" in res.output  # the OE covariance reaches the CLI
     html = (tmp_path / "r" / "report.html").read_text()
     assert "identify report (OE (output error) model)" in html
-    plain = CliRunner().invoke(cli, args)
+    plain = CliRunner().invoke(cli, [*args, "--estimator", "lpc"])
     assert plain.exit_code == 0 and plain.output.startswith("LPC model  na=2")

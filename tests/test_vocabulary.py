@@ -225,7 +225,8 @@ def test_identify_na_nb(tmp_path, record):
     assert '"na": 2, "nb": 1, "nk": 1' in res.output
     assert "MATLAB" in _run("identify", "--help").output
     assert ref.num.size == 3  # nk = 1 leading zero, then nb + 1 = 2 coefficients
-    bad = _run("identify", path, "-u", "u", "-y", "y", "--order", "auto", "--na", "2")
+    lpc = ("--estimator", "lpc", "--nk", "0")
+    bad = _run("identify", path, "-u", "u", "-y", "y", "--order", "auto", "--na", "2", *lpc)
     assert bad.exit_code == 2 and "order auto" in bad.output
 
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sys
+import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -81,8 +84,8 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
         mark = "  <- chosen" if r["chosen"] else ""
         note = f"  ({r['note']})" if r["note"] else ""
         lines.append(
-            f"  {r['estimator'].upper():<3} N={r['order']} nk={r['nk']}{out}: free run "
-            f"{pct(r['free_run'])}, {found.horizon}-step {pct(r['kstep'])}, "
+            f"  {r['estimator'].upper():<3} na={r['na']} nb={r['nb']} nk={r['nk']}{out}: free "
+            f"run {pct(r['free_run'])}, {found.horizon}-step {pct(r['kstep'])}, "
             f"{r['stability']}{mark}{note}"
         )
     lines.append(f"  reason: {found.reason}")
@@ -97,14 +100,15 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     "--order",
     "-n",
     type=OrderType(),
-    default="2",
+    default="auto",
     show_default=True,
-    help="Model order N (na = nb = N), or 'auto' (see --criterion, over 1..--max-order).",
+    help="Model order N (na = nb = N), or 'auto': na 1..--max-order and nb 0..--max-order "
+    "screened independently (with --estimator lpc: N by --criterion).",
 )
 @click.option(
     "--max-order",
     type=click.IntRange(min=1),
-    default=6,
+    default=10,
     show_default=True,
     help="Largest order tried by --order auto.",
 )
@@ -113,9 +117,9 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     type=click.Choice(["validation", "bic", "aic", "remark1"]),
     default="validation",
     show_default=True,
-    help="How --order auto chooses: on the last third held out, the mean of the free-run "
-    "and the k-step prediction fit (k: one dominant time constant), unstable orders "
-    "rejected (validation); BIC, AIC or the paper's Remark 1.",
+    help="How --estimator lpc --order auto chooses: on the last third held out, the mean of "
+    "the free-run and the k-step prediction fit (k: one dominant time constant), unstable "
+    "orders rejected (validation); BIC, AIC or the paper's Remark 1.",
 )
 @click.option(
     "--na",
@@ -133,19 +137,27 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
 @click.option(
     "--nk",
     type=DelayType(),
-    default="0",
+    default="auto",
     show_default=True,
     help="Input delay in samples (0: b0 acts at once, as in the paper; a physical plant with "
-    "no direct feed-through has nk >= 1, as MATLAB's default), or 'auto' (0..4 compared on "
-    "held-out data; implies --estimator lpc unless --estimator is given).",
+    "no direct feed-through has nk >= 1, as MATLAB's default), or 'auto' (0..--max-delay "
+    "compared on held-out data).",
+)
+@click.option(
+    "--max-delay",
+    type=click.IntRange(min=0),
+    default=5,
+    show_default=True,
+    help="Largest delay tried by --nk auto.",
 )
 @click.option(
     "--estimator",
     type=click.Choice(ESTIMATORS),
-    default=None,
-    help="Compare LPC, least squares (arx) and output error (oe) on held-out data, print the "
-    "table and the reason, and keep this one (auto: the best stable free run). Default: LPC "
-    "alone, no comparison.",
+    default="auto",
+    show_default=True,
+    help="auto: screen the structures by least squares, compare least squares (arx), LPC and "
+    "output error (oe) on held-out data, print the table and the reason, keep the best; "
+    "arx or oe: the same, keeping that one; lpc: the paper's LPC alone, no comparison.",
 )
 @method_option()
 @click.option(
@@ -166,21 +178,23 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
 @record_settings()
 @collect("settings", IdentifySettings)
 def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> None:
-    """Identify a linear model -B(z)/A(z) from a record with batch LPC.
+    """Identify a linear model -B(z)/A(z) from a record: structure and estimator chosen.
 
-    Prints the monic transfer function (powers of z^-1), poles and stability, the degree of
-    linearity D, the fit % of the free-run simulation and of 1- and 10-step predictions on
-    the same data, and whether the data determine the model. With --estimator (or --nk
-    auto) LPC, least squares and output error are first compared on held-out data.
+    By default the orders na, nb and the delay nk are screened by least squares, least
+    squares, LPC and output error are compared on held-out data at the best structures, and
+    the best is kept (the table and the reason are printed; a progress line per stage on a
+    terminal). Then the monic transfer function (powers of z^-1), poles and stability, the
+    fit % of the free-run simulation and of 1- and 10-step predictions on the same data,
+    and whether the data determine the model. --estimator lpc fits the paper's LPC alone.
 
     \b
     Examples:
-      clpc identify dryer.csv --input u --output y --order 2 --dt 0.08
-      clpc identify run.csv -u torque -y position --order auto --time t --save m.json
+      clpc identify dryer.csv --input u --output y --dt 0.08
+      clpc identify run.csv -u torque -y position --time t --save m.json
       clpc identify arm.csv -u u1 -u u2 -y y1 -y y2 --json
-      clpc identify dryer.csv -u u -y y --estimator auto --nk auto
+      clpc identify dryer.csv -u u -y y --estimator lpc --order 2 --nk 0
     """  # noqa: D301
-    result = identify_file(settings)
+    result = identify_file(settings, _progress())
     if as_json:
         echo_json(result.summary)
         return
@@ -195,16 +209,29 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
         click.echo(f"wrote {_write_report(settings, result, report)}")
 
 
+def _progress() -> Callable[[str], None] | None:
+    """One line per stage on stderr when it is a terminal (``None`` otherwise)."""
+    if not sys.stderr.isatty():
+        return None
+    start = time.perf_counter()
+
+    def say(line: str) -> None:
+        click.echo(f"[{time.perf_counter() - start:5.1f} s] {line}", err=True)
+
+    return say
+
+
 def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: str) -> Any:
     """The HTML report of a fit (:func:`clpc.report.write_identify_report`)."""
     record = settings.record
     shown = {
         "file": record.file,
+        "estimator": settings.estimator,
         "order": settings.order,
         "nk": settings.nk,
         "method": settings.method,
         "mimo": settings.mimo,
-        "criterion": settings.criterion if settings.order == "auto" else None,
+        "criterion": settings.criterion if not settings.compares else None,
     }
     files = write_identify_report(
         folder,

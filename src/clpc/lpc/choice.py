@@ -1,13 +1,20 @@
 """The choice among the candidates of :func:`clpc.identify` (rows of its table).
 
-* **Stability first** (:func:`tier`): the candidates whose poles are all strictly inside the
-  unit circle at every origin, then those on it, then the unstable ones.
+* **Usable first** (:func:`tier`): the candidates with a finite held-out free run, no pole
+  beyond the integrator tolerance (:data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL`: a pole at
+  1.002 and one at 0.998 are the same integrator, ranked by their scores, not by which side
+  of 1 they landed) and no origin where the free run falls more than :data:`GUARD` points
+  below the **reference** (the least-squares ARX of the structure screen's choice at that
+  origin). Then the candidates that fall below the reference somewhere, then the unstable,
+  then those without a finite free run. A catastrophic candidate (a good mean made of one
+  origin at 90 % and one at -1475 %) is never chosen while a usable one exists.
 * **Best mean free run**, with one exception: **OE is kept** when the best candidate beats it
   by no more than the standard error of their differences over the origins
   (:func:`oe_margin`; a one-standard-error rule). OE minimises the very free-run error that
   is scored and is consistent under output noise; a lead smaller than its own spread over
   the origins is not evidence against it.
-* **Order**: the lowest within :data:`PARSIMONY` points of the best order's mean free run.
+* **Structure**: among structures (``na, nb, nk``; the outputs' picks averaged) of the best
+  tier, the fewest parameters within :data:`PARSIMONY` points of the best mean free run.
 
 Every threshold of these rules lives here.
 """
@@ -19,23 +26,62 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PARSIMONY", "best_row", "choose", "oe_lead", "oe_margin", "ranked", "tier"]
+from clpc.lpc.heldout import UNIT_CIRCLE_TOL
 
-#: Points of free-run fit a lower order or a smaller delay may give away.
+__all__ = [
+    "GUARD",
+    "PARSIMONY",
+    "best_row",
+    "choose",
+    "guarded",
+    "oe_lead",
+    "oe_margin",
+    "ranked",
+    "tier",
+]
+
+#: Points of free-run fit a structure with fewer parameters may give away.
 PARSIMONY = 1.0
-_USABLE = ("stable", "integrating")
+#: Points below the reference's free run, at any one origin, that disqualify a candidate.
+GUARD = 20.0
 
 
 def tier(row: dict[str, Any]) -> int:
-    """0: every pole strictly inside the unit circle (every origin); 1: on it; 2: unstable.
+    """0: usable; 1: below the reference at some origin; 2: unstable; 3: no finite free run.
 
-    3: no finite free-run fit.
+    Usable: every origin's free run finite, no pole beyond ``1 + UNIT_CIRCLE_TOL`` and
+    ``row["guard"]`` (set by :func:`guarded`) not ``False``.
     """
-    if not math.isfinite(row["free_run"]):
+    if not (math.isfinite(row["free_run"]) and np.all(np.isfinite(row["windows"]))):
         return 3
-    if row["max_pole"] < 1.0:
-        return 0
-    return 1 if row["stability"] in _USABLE else 2
+    if not row["max_pole"] <= 1.0 + UNIT_CIRCLE_TOL:
+        return 2
+    return 1 if row.get("guard") is False else 0
+
+
+def guarded(rows: list[dict[str, Any]], reference: dict[str, list[float]]) -> None:
+    """Mark each row's ``guard``: within :data:`GUARD` points of the reference at every origin.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Candidate rows (``output``, ``windows``); each gets ``guard`` (bool) and, when it
+        fails, a ``note`` with the origin and the two fits.
+    reference : dict
+        Per output name, the reference's free-run fit % at each origin.
+    """
+    for row in rows:
+        ref = np.asarray(reference[row["output"]], dtype=float)
+        own = np.asarray(row["windows"], dtype=float)
+        with np.errstate(invalid="ignore"):
+            low = own < ref - GUARD
+        row["guard"] = not bool(np.any(low))
+        if low.any():
+            o = int(np.argmax(low))
+            row["note"] = (
+                f"origin {o + 1}: free run {own[o]:.1f} %, more than {GUARD:g} points below "
+                f"the least-squares reference's {ref[o]:.1f} %: not chosen"
+            )
 
 
 def oe_margin(best: dict[str, Any], oe: dict[str, Any]) -> tuple[float, float]:
@@ -50,17 +96,18 @@ def oe_margin(best: dict[str, Any], oe: dict[str, Any]) -> tuple[float, float]:
     return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size))
 
 
-def oe_lead(rows: list[dict[str, Any]], i: int) -> tuple[float, float, dict[str, Any]] | None:
-    """For a chosen OE row ``i``: the best stable rival's lead, its standard error, the rival.
+def _same(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Same structure and output."""
+    return all(a.get(f) == b.get(f) for f in ("na", "nb", "nk", "output"))
 
-    (:func:`oe_margin`); ``None`` when no strictly stable rival leads.
+
+def oe_lead(rows: list[dict[str, Any]], i: int) -> tuple[float, float, dict[str, Any]] | None:
+    """For a chosen OE row ``i``: the best usable rival's lead, its standard error, the rival.
+
+    (:func:`oe_margin`, same structure and output); ``None`` when no usable rival leads.
     """
     r = rows[i]
-    rivals = [
-        x
-        for x in rows
-        if x is not r and x["order"] == r["order"] and x["output"] == r["output"] and tier(x) == 0
-    ]
+    rivals = [x for x in rows if x is not r and _same(x, r) and tier(x) == 0]
     if r["estimator"] != "oe" or not rivals:
         return None
     top = max(rivals, key=lambda x: x["free_run"])
@@ -83,31 +130,58 @@ def ranked(rows: list[dict[str, Any]], idx: list[int]) -> list[int]:
 
 
 def best_row(rows: list[dict[str, Any]], idx: list[int]) -> tuple[int, bool]:
-    """The chosen row among ``idx`` and whether it is strictly stable."""
+    """The chosen row among ``idx`` and whether it is usable (tier 0)."""
     top = ranked(rows, idx)[0]
     return top, tier(rows[top]) == 0
 
 
 def choose(
     rows: list[dict[str, Any]], estimator: str, names: tuple[str, ...]
-) -> tuple[int, list[int]]:
-    """The chosen order and, per output, the index of the chosen row."""
-    orders = sorted({r["order"] for r in rows})
-    picks: dict[int, list[int]] = {}
-    mean: dict[int, float] = {}
-    for n in orders:
-        picks[n] = []
+) -> tuple[tuple[int, int, int], list[int]]:
+    """The chosen structure ``(na, nb, nk)`` and, per output, the index of the chosen row.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The candidates (``estimator``, ``na``, ``nb``, ``nk``, ``n_params``, ``output``, ...).
+    estimator : str
+        ``"auto"`` or the one estimator to keep.
+    names : tuple of str
+        The output names.
+
+    Returns
+    -------
+    structure : tuple of int
+    picks : list of int
+        One row index per output.
+    """
+    keys = sorted({(r["na"], r["nb"], r["nk"]) for r in rows})
+    picks: dict[tuple[int, int, int], list[int]] = {}
+    rank: dict[tuple[int, int, int], tuple[int, float, int]] = {}
+    for key in keys:
+        picks[key] = []
         for out in names:
             idx = [
                 i
                 for i, r in enumerate(rows)
-                if r["order"] == n and r["output"] == out and estimator in ("auto", r["estimator"])
+                if (r["na"], r["nb"], r["nk"]) == key
+                and r["output"] == out
+                and estimator in ("auto", r["estimator"])
             ]
-            picks[n].append(best_row(rows, idx)[0])
-        mean[n] = float(np.mean([rows[i]["free_run"] for i in picks[n]]))
-    finite = [n for n in orders if math.isfinite(mean[n])] or orders
-    top = max(mean[n] for n in finite)
-    best = (
-        min(n for n in finite if not mean[n] < top - PARSIMONY) if math.isfinite(top) else orders[0]
-    )
+            if idx:
+                picks[key].append(best_row(rows, idx)[0])
+        if len(picks[key]) < len(names):
+            del picks[key]
+            continue
+        chosen = [rows[i] for i in picks[key]]
+        mean = float(np.mean([r["free_run"] for r in chosen]))
+        rank[key] = (max(tier(r) for r in chosen), mean, int(chosen[0]["n_params"]))
+    if not rank:
+        raise ValueError(f"no candidate of the estimator {estimator!r} in the table.")
+    best_tier = min(t for t, _, _ in rank.values())
+    pool = [key for key in rank if rank[key][0] == best_tier]
+    top = max(rank[key][1] for key in pool)
+    if math.isfinite(top):
+        pool = [key for key in pool if not rank[key][1] < top - PARSIMONY]
+    best = min(pool, key=lambda key: (rank[key][2], -rank[key][1]))
     return best, picks[best]

@@ -1,47 +1,49 @@
-"""``identify``: the best of LPC, least squares and output error for a record, and why.
+"""``identify``: the structure and the estimator for a record, and why.
 
-Every candidate (estimator x order) is scored on data it was not fitted to, forward in time
-at three rolling origins: fitted on the first 1/2, 2/3 and ``1 - f`` of the record
-(``f = validation_fraction``, default 0.2) and scored on all the rest each time, as the
-final model is fitted on the record and used after it. Each origin gives, per output, the
-**free-run** fit % (the simulation from the input alone, started from the measured samples
-before the scored ones) and the **k-step** prediction fit % (``k``: one dominant time
-constant of the least-squares model fitted on the first half,
+Two stages, both scored on data the fits did not see, forward in time at three rolling
+origins: fitted on the first 1/2, 2/3 and ``1 - f`` of the record (``f =
+validation_fraction``, default 0.2) and scored on all the rest each time, as the final model
+is fitted on the record and used after it. Each origin gives, per output, the **free-run**
+fit % (the simulation from the input alone, started from the measured samples before the
+scored ones) and the **k-step** prediction fit % (``k``: one dominant time constant of the
+least-squares model of the screen's choice fitted on the first half,
 :func:`clpc.lpc.heldout.horizon`); the table holds their means over the origins
 (``windows``: the free runs one by one).
 
-* **Choice**, per output (:mod:`clpc.lpc.choice`): among the candidates whose poles are all
-  strictly inside the unit circle at every origin (if there are none: among those within
-  :data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL` of it, then among the rest), the highest mean
-  free-run fit, except that OE is kept when that candidate leads it by no more than the
-  standard error of their differences over the origins. The model is meant to simulate the
-  process, and the free run is the stricter test (a prediction re-reads the measured output
-  every ``k`` samples); OE minimises that very error and is consistent under output noise.
-  So an unstable model is never chosen while a stable candidate exists; OE is stable by
-  construction, so one always does when OE can be fitted. A choice whose refit on the whole
-  record is unstable gives way to the next candidate
-  (:func:`clpc.lpc.comparison.stable_refits`). Outputs are separate equations, so a
-  multi-output model may take each output from another estimator (``info["estimators"]``).
-* **Order** (``order="auto"``): the lowest order whose mean over the outputs of the chosen
-  free-run fits is within :data:`PARSIMONY` points of the best order's.
-* **Delay** (``nk="auto"``): every candidate at each ``nk`` in ``0..max_delay``; the ``nk``
-  whose chosen candidates have the best mean free run wins (every delay has as many
-  parameters, so no parsimony; the closed-form fits alone are misled by their bias: least
-  squares and LPC under output noise can fit better with a wrong delay).
+* **Structure screen** (:mod:`clpc.lpc.screen`, :mod:`clpc.lpc.search_space`): every
+  ``(na, nb, nk)`` in the ranges (``na`` 1..10, ``nb`` 0..10, ``nk`` 0..5 by default,
+  independently) as least squares, in microseconds each; the ``shortlist`` best go on (the
+  fewest coefficients within :data:`clpc.lpc.screen.PARSIMONY` of the best first).
+* **Candidates** (:mod:`clpc.lpc.comparison`): least squares, LPC and OE at each
+  shortlisted structure (OE started at each later origin from the previous optimum).
+* **Choice**, per output (:mod:`clpc.lpc.choice`): among the usable candidates (stable or
+  integrating within :data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL`, never more than
+  :data:`clpc.lpc.choice.GUARD` points below the screen's least-squares choice at any
+  origin), the highest mean free-run fit, except that OE is kept when that candidate leads
+  it by no more than the standard error of their differences over the origins; then the
+  structure with the fewest coefficients within :data:`clpc.lpc.choice.PARSIMONY` points.
+  The model is meant to simulate the process, and the free run is the stricter test (a
+  prediction re-reads the measured output every ``k`` samples); OE minimises that very
+  error and is consistent under output noise. So an unstable or catastrophic model is
+  never chosen while a usable candidate exists. A choice whose refit on the whole record
+  is unstable gives way to the next candidate (:func:`clpc.lpc.comparison.stable_refits`).
+  Outputs are separate equations, so a multi-output model may take each output from
+  another estimator (``info["estimators"]``), at one structure.
 * **Errors in variables**: :func:`clpc.lpc.eiv.check_eiv` on the whole record at the chosen
   structure.
 
 The chosen estimators are then refitted on the whole record.
 
-Why this rule: ``benchmarks/selection_rules.py`` measured 20 rules on the real records
-split four ways and on simulated ones (``docs/method.md``); scoring forward in time was
-better on the real records than the earlier two folds (one fitted on the last two thirds and
-scored on the first third), and folds scored backward in time were the worst.
+Why rolling origins: ``benchmarks/selection_rules.py`` measured 20 rules on the real
+records split four ways and on simulated ones (``docs/method.md``); scoring forward in time
+was better on the real records than the earlier two folds (one fitted on the last two
+thirds and scored on the first third), and folds scored backward in time were the worst.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,18 +52,22 @@ import numpy as np
 from clpc.core.checks import check_choice, check_int
 from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
-from clpc.lpc.arx import ARX
-from clpc.lpc.choice import choose, oe_lead, tier
+from clpc.lpc.choice import GUARD, choose, guarded, oe_lead, tier
 from clpc.lpc.comparison import (
-    choose_delay,
+    FAMILIES,
+    candidate,
     final_model,
-    grid,
+    key,
+    make,
     rolling_origin,
     stable_refits,
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
-from clpc.lpc.oe import OE
+from clpc.lpc.gain_choice import prefer_determined_gain
+from clpc.lpc.screen import screen
+from clpc.lpc.search_space import search_space
 from clpc.model import LinearModel, ModelError
+from clpc.model.structure import Structure, check_mode, default_mode
 
 __all__ = ["ESTIMATORS", "Identification", "identify", "pct"]
 
@@ -78,21 +84,24 @@ class Identification:
     model : LinearModel
         The chosen model, refitted on the whole record.
     table : list of dict
-        One row per candidate and output: ``estimator``, ``order``, ``nk``, ``output``,
-        ``free_run``, ``kstep`` (fit %, mean over the three origins, ``-inf`` when one
-        diverges), ``windows`` (the free-run fit % at each origin), ``stability`` (the worst
-        of the origins' models), ``chosen`` and ``note`` (why a fit failed or a choice gave
-        way). ``pandas.DataFrame(table)`` makes it a frame.
+        One row per candidate and output: ``estimator``, ``na``, ``nb``, ``nk``, ``order``
+        (``na``), ``n_params``, ``output``, ``free_run``, ``kstep`` (fit %, mean over the
+        three origins, ``-inf`` when one diverges), ``windows`` (the free-run fit % at each
+        origin), ``stability`` (the worst of the origins' models), ``max_pole``, ``guard``
+        (within :data:`clpc.lpc.choice.GUARD` points of the reference at every origin),
+        ``chosen`` and ``note`` (why a fit failed or a choice gave way).
+        ``pandas.DataFrame(table)`` makes it a frame.
     reason : str
-        Why this model, in words (with the delay and the errors-in-variables check).
+        Why this model, in words (the screen, the choice, the errors-in-variables check).
     estimators : tuple of str
         The chosen estimator per output (``"lpc"``, ``"arx"`` or ``"oe"``).
-    order, nk : int
-        The chosen structure (``na = nb = order``).
+    structure : Structure
+        The chosen orders and delay.
     horizon : int
         The prediction horizon ``k`` [samples].
-    delays : list of dict
-        ``nk="auto"`` only: ``nk`` and ``free_run`` (best stable closed-form fit %).
+    screen : list of dict
+        The structure screen: ``na``, ``nb``, ``nk``, ``n_params`` and ``free_run`` (mean
+        least-squares held-out free-run fit %) per structure.
     eiv : EivCheck or None
         The errors-in-variables check (``None`` when OE or LPC could not be fitted).
     """
@@ -101,16 +110,25 @@ class Identification:
     table: list[dict[str, Any]]
     reason: str
     estimators: tuple[str, ...]
-    order: int
-    nk: int
+    structure: Structure
     horizon: int
-    delays: list[dict[str, Any]]
+    screen: list[dict[str, Any]]
     eiv: EivCheck | None
 
     @property
     def estimator(self) -> str:
         """The chosen estimator (``"mixed"`` when the outputs took different ones)."""
         return self.estimators[0] if len(set(self.estimators)) == 1 else "mixed"
+
+    @property
+    def order(self) -> int:
+        """The chosen output order ``na``."""
+        return self.structure.na
+
+    @property
+    def nk(self) -> int:
+        """The chosen input delay [samples]."""
+        return self.structure.nk
 
     def to_frame(self) -> Any:
         """:attr:`table` as a pandas DataFrame (needs pandas)."""
@@ -125,30 +143,39 @@ def identify(
     dt: float | None = None,
     estimator: str = "auto",
     *,
-    order: int | str = 2,
-    nk: int | str = 0,
-    max_order: int = 6,
-    max_delay: int = 4,
+    order: int | str = "auto",
+    na: int | None = None,
+    nb: int | None = None,
+    nk: int | str = "auto",
+    max_order: int = 10,
+    max_delay: int = 5,
     mimo: str | None = None,
     k: int | None = None,
     validation_fraction: float = 0.2,
+    shortlist: int = 3,
+    progress: Callable[[str], None] | None = None,
 ) -> Identification:
-    """Fit LPC, least squares (ARX) and output error (OE); return the best with the evidence.
+    """Choose structure and estimator for a record; return the model with the evidence.
 
     Parameters
     ----------
     u, y, dt
         The record (see :meth:`clpc.LPC.fit`).
     estimator : {"auto", "lpc", "arx", "oe"}
-        ``"auto"``: per output, the best held-out free run among the stable candidates, OE
+        ``"auto"``: per output, the best held-out free run among the usable candidates, OE
         within one standard error (see the module); otherwise that estimator (the table
-        still compares all three).
+        still compares all).
     order : int or "auto"
-        Model order ``N`` (``na = nb = N``) or ``"auto"`` (``1..max_order``).
+        ``"auto"`` (default): ``na`` in ``1..max_order`` and ``nb`` in ``0..max_order``
+        screened independently; an int ``N``: ``na = nb = N``.
+    na, nb : int, optional
+        Fix the output order or the input order (clpc's ``nb``: ``nb + 1`` coefficients
+        per input) and screen the other.
     nk : int or "auto"
-        Input delay [samples] or ``"auto"`` (``0..max_delay``).
+        Input delay [samples] or ``"auto"`` (``0..max_delay``, default).
     max_order, max_delay : int
-        Ranges of ``order="auto"`` and ``nk="auto"``.
+        Ranges of the automatic search (``max_order`` is lowered, with a note in the
+        reason, when the record is too short for it).
     mimo : {"siso", "paired", "miso"}, optional
         Multi-channel structure (default as :class:`clpc.LPC`).
     k : int, optional
@@ -156,6 +183,10 @@ def identify(
     validation_fraction : float
         Share of the record scored from the last origin (0 < f <= 0.25; the other origins
         are at 1/2 and 2/3 of the record).
+    shortlist : int
+        How many screened structures the estimators are fitted on (>= 1).
+    progress : callable, optional
+        Called with one line of text at each stage (the screen, each estimator family).
 
     Returns
     -------
@@ -167,70 +198,101 @@ def identify(
     ValueError
         Invalid settings.
     DataError
-        A record too short for the largest candidate.
+        A record too short for the smallest candidate.
     """
     check_choice(estimator, "estimator", ESTIMATORS)
-    orders = _range(order, "order", 1, max_order)
-    delays = _range(nk, "nk", 0, max_delay)
+    check_int(shortlist, "shortlist", 1)
     if not 0.0 < validation_fraction <= 0.25:
         raise ValueError(
             f"validation_fraction must be in (0, 0.25] (the last origin is at 1 - f, after "
             f"the others at 1/2 and 2/3); got {validation_fraction!r}."
         )
+    say = progress or (lambda line: None)
     data = as_iodata(u, y, dt)
-    folds = rolling_origin(data, validation_fraction)
-    n_fit, n_val = folds[0][0].n_samples, folds[-1][1].n_samples
-    need = 4 * (max(orders) + max(delays) + 2) * (data.n_inputs + 1)
-    if n_fit < need or n_val < need // 2:
+    names = (*data.input_names, *data.output_names)
+    columns = (*data.u.T, *data.y.T)
+    flat = [n for n, col in zip(names, columns, strict=True) if np.ptp(col) == 0]
+    if flat:
         raise DataError(
-            f"identify needs at least {need} samples before the first origin and {need // 2} "
-            f"after the last (order {max(orders)}, delay {max(delays)}, {data.n_inputs} "
-            f"input(s)); got {n_fit} and {n_val} of {data.n_samples}. Use a longer record, a "
-            "lower max order or max delay, or a larger validation_fraction."
+            f"nothing to identify: constant channel(s) {flat}. identify needs inputs and "
+            "outputs that vary over the record."
         )
+    mode = mimo or default_mode(data.n_inputs, data.n_outputs)
+    check_mode(mode, data.n_inputs, data.n_outputs)
+    folds = rolling_origin(data, validation_fraction)
+    blocks = data.n_inputs if mode == "miso" else 1
+    space = search_space(folds, (order, na, nb, nk), (max_order, max_delay), blocks)
+    say(f"structure screen: {len(space.structures)} structures by least squares")
+    scr = screen(folds, space.structures, mode)
+    short = [scr.structures[i] for i in scr.shortlist(shortlist)]
     if k is None:
-        lowest = ARX(order=orders[0], mimo=mimo, assess=False).fit(folds[0][0])  # type: ignore[arg-type]
+        lowest = make("arx", short[0], mode).fit(folds[0][0])
         k = heldout.horizon(lowest, folds[0][1].n_samples)
     k = check_int(k, "k", 1)
-    delay_rows: list[dict[str, Any]] = []
-    if len(delays) > 1:
-        chosen_nk, delay_rows, rows = choose_delay(folds, orders, delays, (mimo, k))
-    else:
-        chosen_nk = delays[0]
-        rows = grid(folds, orders, chosen_nk, (mimo, k))
-    names = data.output_names
-    pick_order, first = choose(rows, estimator, names)
-    picks = stable_refits(data, rows, first, mimo) if estimator == "auto" else first
+    rows, last_oe = _candidates(folds, short, (mode, k), say)
+    # the reference: least squares at the screen's choice (the first shortlisted structure)
+    guarded(rows, {r["output"]: r["windows"] for r in rows if _is(r, "arx", short[0])})
+    where, first = choose(rows, estimator, data.output_names)
+    picks = stable_refits(data, rows, first, mode) if estimator == "auto" else first
     for i in picks:
         rows[i]["chosen"] = True
     chosen = tuple(rows[i]["estimator"] for i in picks)
-    model = final_model(data, chosen, pick_order, chosen_nk, mimo)
+    structure = Structure(*where)
+    model = final_model(data, chosen, structure, mode, initial=last_oe.get(structure))
+    gain_note = ""
+    if estimator == "auto":
+        model, moved, gain_note = prefer_determined_gain(data, rows, model, picks, mode)
+        if moved != picks:
+            first = picks = moved
+            chosen = tuple(rows[i]["estimator"] for i in picks)
+            structure = Structure(*key(rows[picks[0]]))
     try:
         oe_model = model  # the chosen OE fit, or a new one
         if set(chosen) != {"oe"}:
-            oe_model = OE(order=pick_order, nk=chosen_nk, mimo=mimo, assess=False).fit(data)  # type: ignore[arg-type]
+            oe_model = final_model(
+                data, ("oe",), structure, mode, evidence=False, initial=last_oe.get(structure)
+            )
         eiv: EivCheck | None = check_eiv(data, oe_model)
     except (ModelError, DataError, np.linalg.LinAlgError):
         eiv = None
-    parts = [_why(rows, (first, picks), estimator, (k, validation_fraction), names)]
-    if delay_rows:
-        scan = ", ".join(f"nk={r['nk']}: {r['free_run']:.1f}" for r in delay_rows)
-        parts.append(f"delay nk={chosen_nk}: the best stable held-out free run, per delay: {scan}")
+    parts = [_why(rows, (first, picks), estimator, (k, validation_fraction), data.output_names)]
+    if gain_note:
+        parts.append(gain_note)
+    parts.append(space.describe(scr, short))
     if eiv is not None:
         parts.append(eiv.reason)
-    return Identification(
-        model, rows, "; ".join(parts), chosen, pick_order, chosen_nk, k, delay_rows, eiv
-    )
+    return Identification(model, rows, "; ".join(parts), chosen, structure, k, scr.rows(), eiv)
 
 
-def _range(value: Any, name: str, low: int, high: int) -> list[int]:
-    """``[value]`` or ``low..high`` for ``"auto"``."""
-    if isinstance(value, str):
-        if value != "auto":
-            raise ValueError(f"{name} must be an int or 'auto'; got {value!r}.")
-        high = check_int(high, "max_order" if name == "order" else "max_delay", low)
-        return list(range(low, high + 1))
-    return [check_int(value, name, low)]
+def _is(row: dict[str, Any], name: str, structure: Structure) -> bool:
+    """Whether ``row`` is estimator ``name`` at ``structure``."""
+    return row["estimator"] == name and key(row) == (structure.na, structure.nb, structure.nk)
+
+
+def _candidates(
+    folds: list[Any],
+    short: list[Structure],
+    opts: tuple[str, int],
+    say: Callable[[str], None],
+) -> tuple[list[dict[str, Any]], dict[Structure, LinearModel]]:
+    """Every estimator at every shortlisted structure, scored at the origins.
+
+    Returns the rows (``n_params`` added) and each structure's OE fit at the last origin.
+    """
+    mode, k = opts
+    n_in = folds[0][0].n_inputs
+    blocks = n_in if mode == "miso" else 1
+    rows: list[dict[str, Any]] = []
+    last_oe: dict[Structure, LinearModel] = {}
+    shapes = ", ".join(f"na={s.na} nb={s.nb} nk={s.nk}" for s in short)
+    for name in FAMILIES:
+        say(f"{name.upper()}: {shapes} at {len(folds)} origins")
+        for s in short:
+            got, model = candidate(name, s, mode, (folds, k))
+            rows += [r | {"n_params": s.na + blocks * (s.nb + 1)} for r in got]
+            if name == "oe" and model is not None:
+                last_oe[s] = model
+    return rows, last_oe
 
 
 def _why(
@@ -250,7 +312,7 @@ def _why(
     lead = [oe_lead(rows, i) for i in choice[1]]
     for j, (i0, i) in enumerate(zip(*choice, strict=True)):
         r = rows[i]
-        what = f"{r['estimator'].upper()} (order {r['order']}, nk {r['nk']})"
+        what = f"{r['estimator'].upper()} (na {r['na']}, nb {r['nb']}, nk {r['nk']})"
         out = f"output {names[j]}: " if len(names) > 1 else ""
         each = ", ".join(pct(v) for v in r["windows"])
         fits = (
@@ -260,7 +322,7 @@ def _why(
         others = [
             f"{x['estimator'].upper()} {_fmt(x)}"
             for x in rows
-            if x is not r and x["order"] == r["order"] and x["output"] == r["output"]
+            if x is not r and key(x) == key(r) and x["output"] == r["output"]
         ]
         level = tier(r)
         if estimator != "auto":
@@ -279,14 +341,24 @@ def _why(
                 f"({se:.2f})"
             )
         elif level == 0:
-            how = "the best held-out free run among the stable candidates"
+            how = (
+                "the best held-out free run among the usable candidates (stable or "
+                f"integrating, within {GUARD:g} points of least squares at every origin)"
+            )
         elif level == 1:
-            how = "no candidate is strictly stable; the best of those on the unit circle"
+            how = (
+                f"every candidate falls more than {GUARD:g} points below least squares at "
+                "some origin; the best of them, not a good model"
+            )
         else:
             how = "every candidate is unstable or diverges; the least bad, not a good model"
         parts.append(f"{out}{what}, {how} ({fits}; {', '.join(others)})")
     unstable = sorted(
-        {f"{x['estimator'].upper()} N={x['order']}" for x in rows if x["stability"] == "unstable"}
+        {
+            f"{x['estimator'].upper()} na={x['na']} nb={x['nb']} nk={x['nk']}"
+            for x in rows
+            if x["stability"] == "unstable"
+        }
     )
     text = "; ".join(parts)
     return text + (f"; unstable at an origin: {', '.join(unstable)}" if unstable else "")

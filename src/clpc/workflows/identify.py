@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -11,7 +12,7 @@ import numpy as np
 from clpc.core.checks import check_choice, check_int
 from clpc.core.jsonable import jsonable
 from clpc.io import save_model
-from clpc.lpc import LPC, Identification, OrderSelection, identify, select_order
+from clpc.lpc import LPC, Identification, OrderSelection, identify, select_delay, select_order
 from clpc.lpc.selection import ESTIMATORS
 from clpc.model import LinearModel, MimoMode
 from clpc.report import model_summary
@@ -33,15 +34,20 @@ class IdentifySettings:
     record : RecordSpec
         The record and its input/output columns.
     order : int or "auto"
-        Model order N (``na = nb = N``), or ``"auto"`` to choose it over 1..``max_order``.
+        Model order N (``na = nb = N``), or ``"auto"`` (default) to choose it:
+        :func:`clpc.identify` screens ``na`` 1..``max_order`` and ``nb`` 0..``max_order``
+        independently; LPC alone (``estimator="lpc"``) chooses N in 1..``max_order`` by
+        ``criterion``.
     max_order : int
         Largest order tried by ``order="auto"``.
     criterion : {"validation", "bic", "aic", "remark1"}
-        How ``order="auto"`` chooses.
+        How LPC alone chooses its order (``estimator="lpc"``).
     nk : int or "auto"
-        Input delay in samples, or ``"auto"`` (0..4, :func:`clpc.identify`).
+        Input delay in samples, or ``"auto"`` (default: 0..``max_delay``).
+    max_delay : int
+        Largest delay tried by ``nk="auto"``.
     method : {"robust", "paper"}
-        LPC solution (without ``estimator`` only).
+        LPC solution (``estimator="lpc"`` only).
     mimo : {"miso", "paired"}, optional
         Multi-channel structure.
     save : str, optional
@@ -49,23 +55,25 @@ class IdentifySettings:
     na, nb : int, optional
         Separate output / input orders overriding ``order`` (clpc's meaning: ``nb + 1``
         coefficients per input; MATLAB's ``arx`` nb is clpc's ``nb + 1``).
-    estimator : {"auto", "lpc", "arx", "oe"}, optional
-        Compare LPC, least squares and output error on held-out data (:func:`clpc.identify`)
-        and keep this one (``"auto"``: the best). ``None`` (default): LPC alone, as before,
-        unless ``nk="auto"`` (then ``"lpc"`` with the comparison).
+    estimator : {"auto", "arx", "oe", "lpc"}
+        ``"auto"`` (default): structure and estimator chosen on held-out data among least
+        squares, LPC and output error (:func:`clpc.identify`); ``"arx"`` or ``"oe"``: the
+        same search, keeping that estimator; ``"lpc"``: the paper's LPC alone (its order
+        by ``criterion``, its delay by :func:`clpc.lpc.select_delay`), no comparison.
     """
 
     record: RecordSpec
-    order: int | Literal["auto"] = 2
-    max_order: int = 6
+    order: int | Literal["auto"] = "auto"
+    max_order: int = 10
     criterion: Criterion = "validation"
-    nk: int | Literal["auto"] = 0
+    nk: int | Literal["auto"] = "auto"
     method: Method = "robust"
     mimo: MimoMode | None = None
     save: str | None = None
     na: int | None = None
     nb: int | None = None
-    estimator: str | None = None
+    estimator: str = "auto"
+    max_delay: int = 5
 
     def __post_init__(self) -> None:
         if self.order != "auto":
@@ -78,31 +86,26 @@ class IdentifySettings:
         for name in ("na", "nb"):
             if getattr(self, name) is not None:
                 check_int(getattr(self, name), name, 0 if name == "nb" else 1)
-        if self.order == "auto" and (self.na is not None or self.nb is not None):
-            raise SettingsError("order auto chooses na = nb = N; do not also give na or nb.")
-        if self.estimator is not None:
-            check_choice(self.estimator, "estimator", ESTIMATORS)
+        check_int(self.max_delay, "max_delay", 0)
+        check_choice(self.estimator, "estimator", ESTIMATORS)
         if self.compares:
-            if self.na is not None or self.nb is not None:
-                raise SettingsError(
-                    "na/nb apply to LPC alone; the estimator comparison (estimator or "
-                    "nk='auto') fits na = nb = N. Give --order instead, or drop the comparison."
-                )
             if self.method != "robust":
-                raise ValueError(
+                raise SettingsError(
                     f"method={self.method!r} applies to LPC alone; the estimator comparison "
-                    "(estimator or nk='auto') uses the default LPC. Drop one of the two."
+                    "uses the default LPC. Give estimator 'lpc' for the paper's LPC alone."
                 )
-            if self.order == "auto" and self.criterion != "validation":
-                raise ValueError(
-                    f"criterion={self.criterion!r}: the estimator comparison chooses the order "
-                    "on held-out data only (criterion 'validation')."
+            if self.criterion != "validation":
+                raise SettingsError(
+                    f"criterion={self.criterion!r} applies to LPC alone; the estimator "
+                    "comparison chooses on held-out data. Give estimator 'lpc' for LPC alone."
                 )
+        elif self.order == "auto" and (self.na is not None or self.nb is not None):
+            raise SettingsError("order auto chooses na = nb = N; do not also give na or nb.")
 
     @property
     def compares(self) -> bool:
-        """Whether :func:`identify_file` runs :func:`clpc.identify` (the comparison)."""
-        return self.estimator is not None or self.nk == "auto"
+        """Whether :func:`identify_file` runs :func:`clpc.identify` (not LPC alone)."""
+        return self.estimator != "lpc"
 
 
 @dataclass(frozen=True)
@@ -152,13 +155,17 @@ class IdentifyResult:
         return {"bic": sel.bic, "aic": sel.aic, "remark1": sel.J}[self.criterion]
 
 
-def identify_file(settings: IdentifySettings) -> IdentifyResult:
+def identify_file(
+    settings: IdentifySettings, progress: Callable[[str], None] | None = None
+) -> IdentifyResult:
     """Identify a linear model ``-B(z)/A(z)`` from a record with batch LPC.
 
     Parameters
     ----------
     settings : IdentifySettings
         Record, order (or its selection), structure; where to save the model.
+    progress : callable, optional
+        Called with one line of text per stage of the comparison (:func:`clpc.identify`).
 
     Returns
     -------
@@ -172,10 +179,16 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
     """
     data = settings.record.load()
     if settings.compares:
-        return _compare(settings, data)
-    assert settings.nk != "auto"
+        return _compare(settings, data, progress)
+    nk = settings.nk
+    if nk == "auto":
+        first = 2 if settings.order == "auto" else settings.order
+        delays = range(settings.max_delay + 1)
+        nk = select_delay(
+            data, delays=delays, estimator=LPC(order=first, method=settings.method)
+        ).best
     estimator = LPC(
-        nk=settings.nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
+        nk=nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
     )
     selection = None
     order = settings.order
@@ -208,25 +221,31 @@ def identify_file(settings: IdentifySettings) -> IdentifyResult:
     return IdentifyResult(model, summary, selection, settings.criterion)
 
 
-def _compare(settings: IdentifySettings, data: Any) -> IdentifyResult:
+def _compare(
+    settings: IdentifySettings, data: Any, progress: Callable[[str], None] | None
+) -> IdentifyResult:
     """:func:`identify_file` with the estimator comparison (:func:`clpc.identify`)."""
     found = identify(
         data,
-        estimator=settings.estimator or "lpc",
+        estimator=settings.estimator,
         order=settings.order,
+        na=settings.na,
+        nb=settings.nb,
         nk=settings.nk,
         max_order=settings.max_order,
+        max_delay=settings.max_delay,
         mimo=settings.mimo,
+        progress=progress,
     )
     summary = model_summary(found.model, data)
+    s = found.structure
     summary["comparison"] = jsonable(
         {
             "estimators": list(found.estimators),
-            "order": found.order,
-            "nk": found.nk,
+            "structure": {"na": s.na, "nb": s.nb, "nk": s.nk},
             "horizon": found.horizon,
             "table": found.table,
-            "delays": found.delays,
+            "screened": len(found.screen),
             "reason": found.reason,
             "eiv_violated": None if found.eiv is None else found.eiv.violated,
         }
