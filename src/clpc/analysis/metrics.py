@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
+
 __all__ = ["fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"]
 
 
@@ -129,6 +131,7 @@ def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
     return fit_percent(y_arr[start:], y_hat[start:])
 
 
+@compact_repr
 @dataclass(frozen=True)
 class WhitenessResult:
     """Ljung-Box portmanteau test of residual whiteness."""

@@ -31,6 +31,7 @@ from clpc.appraiser.spread import (
     level_trend,
     window_dc_gains,
 )
+from clpc.core.compact import compact_repr
 from clpc.lpc.arx import ARX
 
 __all__ = [
@@ -80,6 +81,7 @@ def locality(window_ops: np.ndarray, samples: np.ndarray) -> float:
     return float(np.std(window_ops) / s) if s > 0 else 0.0
 
 
+@compact_repr
 @dataclass(frozen=True)
 class OperatingPointReport:
     """Operating-point diagnostics of a trace (one entry per window where arrays).

@@ -9,12 +9,14 @@ lag vectors inside each experiment, never across a boundary.
 
 from __future__ import annotations
 
+import html
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import html_table, summarise
 from clpc.data import processing
 from clpc.data.validation import (
     DataError,
@@ -139,11 +141,22 @@ class IOData:
         return self._with(self.u[index], self.y[index], experiments=parts)
 
     def __repr__(self) -> str:
-        more = f", experiments={list(self.experiments)}" if self.n_experiments > 1 else ""
-        return (
-            f"IOData(n_samples={self.n_samples}, inputs={list(self.input_names)}, "
-            f"outputs={list(self.output_names)}, dt={self.dt:g}{more})"
+        more = (
+            f", experiments={summarise(list(self.experiments))}" if self.n_experiments > 1 else ""
         )
+        return (
+            f"IOData(n_samples={self.n_samples}, inputs={summarise(list(self.input_names))}, "
+            f"outputs={summarise(list(self.output_names))}, dt={self.dt:g}{more})"
+        )
+
+    def _repr_html_(self) -> str:
+        """The record as an HTML table (Jupyter): sample time, experiments, every channel."""
+        rows = [("samples", str(self.n_samples)), ("dt [s]", f"{self.dt:g}")]
+        if self.n_experiments > 1:
+            rows.append(("experiments", html.escape(summarise(list(self.experiments)))))
+        for names, values in ((self.input_names, self.u), (self.output_names, self.y)):
+            rows += [(n, html.escape(summarise(values[:, i]))) for i, n in enumerate(names)]
+        return html_table("IOData", rows)
 
     def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> IOData:
         """A new record with these samples and this record's names."""

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.model.simulation import noise_models
 
 __all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
@@ -86,6 +87,7 @@ class ResidualTest:
         )
 
 
+@compact_repr
 @dataclass(frozen=True)
 class ResidualAnalysis:
     """Correlations of the residuals, their bands and the tests (see the module).

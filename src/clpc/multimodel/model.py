@@ -17,10 +17,12 @@ and their stability guard: :mod:`clpc.multimodel.local`; saving: :mod:`clpc.mult
 
 from __future__ import annotations
 
+import html
 from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import html_table, summarise
 from clpc.data import as_iodata
 from clpc.model import LinearModel
 from clpc.model.errors import as_2d
@@ -388,3 +390,11 @@ class MultiModel:
         s = self.structure
         m = "unfitted" if self._fitted is None else f"n_models={self.n_models}"
         return f"MultiModel(na={s.na}, nb={s.nb}, nk={s.nk}, {m}, schedule={self.schedule_spec!r})"
+
+    def _repr_html_(self) -> str:
+        """The multi-model as an HTML table (Jupyter): its validity functions, its models."""
+        rows = [("multi-model", html.escape(repr(self)))]
+        if self._fitted is not None:
+            rows += [(n, html.escape(summarise(getattr(self, n)))) for n in ("centres", "widths")]
+            rows += [(f"model {i}", m._repr_html_()) for i, m in enumerate(self.local_models)]
+        return html_table("MultiModel", rows)
