@@ -385,8 +385,10 @@ class LinearModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
-            Input samples.
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Input samples, or a record (its inputs; a record of several experiments is
+            simulated one experiment at a time, each from zero initial conditions, and
+            stacked).
         y_init : array_like, shape (na,) or (na, n_outputs), optional
             The ``na`` outputs just before ``u[0]``, oldest first. Default: zeros.
         u_init : array_like, shape (nk+nb,) or (nk+nb, n_inputs), optional
@@ -398,12 +400,13 @@ class LinearModel:
         Returns
         -------
         ndarray, shape (T,) for a SISO model given 1-D ``u``, else (T, n_outputs)
+            (a record's ``y`` shape).
         """
         return simulation.simulate(
             self, u, y_init=y_init, u_init=u_init, include_offset=include_offset
         )
 
-    def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
+    def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
 
         Each prediction uses measured outputs up to ``n - k`` and the model for the rest
@@ -418,14 +421,18 @@ class LinearModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Measured inputs, or a record (its inputs and outputs; then leave ``y`` out and
+            give ``k`` by keyword: ``predict(data, k=10)``). A record of several experiments
+            is predicted one experiment at a time, and stacked.
         y : array_like, shape (T,) or (T, n_outputs)
+            Measured outputs (required with array inputs).
         k : int
             Prediction horizon in samples (>= 1).
 
         Returns
         -------
-        ndarray, same shape as ``y``
+        ndarray, same shape as ``y`` (a record's ``y`` shape)
         """
         return simulation.predict(self, u, y, k)
 
@@ -438,8 +445,8 @@ class LinearModel:
 
         Parameters
         ----------
-        y : array_like, shape (T,)
-            Measured output.
+        y : array_like, shape (T,), or IOData
+            Measured output, or a record of one experiment (its output).
         y_init : array_like, shape (na,), optional
             Outputs before ``y[0]`` (oldest first). Default: ``y[0]`` repeated (rest).
         allow_unstable : bool

@@ -6,11 +6,14 @@ The model's methods of the same names call these functions (``model`` is a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from clpc.core.filters import all_pole, fir
+from clpc.data import DataError, IOData
+from clpc.data.signals import signals
 from clpc.model.errors import ModelError, as_2d
 
 __all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
@@ -75,6 +78,12 @@ def simulate(
     include_offset: bool = True,
 ) -> np.ndarray:
     """Free-run simulation from the input alone (see :meth:`clpc.LinearModel.simulate`)."""
+    stacked = _by_experiment(
+        u, lambda part: simulate(model, part, include_offset=include_offset), y_init, u_init
+    )
+    if stacked is not None:
+        return stacked
+    u, _ = signals(u, what="simulate", needs_y=False)
     u2, was_1d = as_2d(u, model.n_inputs, "u")
     x = forced(model, u2, u_init)
     if include_offset:
@@ -93,7 +102,21 @@ def simulate(
     return y[:, 0] if (was_1d and model.n_outputs == 1) else y
 
 
-def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
+def _by_experiment(
+    data: Any, run: Callable[[IOData], np.ndarray], *initial: Any
+) -> np.ndarray | None:
+    """``run`` on each experiment of a record of several, stacked; ``None`` for others."""
+    if not (isinstance(data, IOData) and data.n_experiments > 1):
+        return None
+    if any(x is not None for x in initial):
+        raise DataError(
+            "initial conditions (y_init, u_init) are for one experiment; this record holds "
+            f"{data.n_experiments}: simulate them one at a time (data.split())."
+        )
+    return np.concatenate([run(part) for part in data.split()])
+
+
+def predict(model: Any, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
     """``k``-step-ahead prediction ``y_hat(n | n-k)`` (:meth:`clpc.LinearModel.predict`).
 
     Equation-error outputs: the recursion below (measured outputs up to ``n - k``, the
@@ -104,6 +127,11 @@ def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
     """
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
+    if y is None:
+        stacked = _by_experiment(u, lambda part: predict(model, part, k=k))
+        if stacked is not None:
+            return stacked
+    u, y = signals(u, y, what="predict")
     u2, _ = as_2d(u, model.n_inputs, "u")
     y2, y_1d = as_2d(y, model.n_outputs, "y")
     if u2.shape[0] != y2.shape[0]:
@@ -193,6 +221,8 @@ def infer_input(
 ) -> np.ndarray:
     """The input that explains a measured output (:meth:`clpc.LinearModel.infer_input`)."""
     model._siso("infer_input")
+    if isinstance(y, IOData):
+        y = signals(y, what="infer_input")[1]
     y2, _ = as_2d(y, 1, "y")
     yv = y2[:, 0]
     s = model.structure
