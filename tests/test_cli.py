@@ -79,7 +79,7 @@ def test_datasets_lists_paths():
 def test_identify_text_on_shipped_record():
     out = ok("identify", DRYER, "--input", "u", "--output", "y", "--dt", "0.08").output
     for word in (
-        "A(z) = 1 -",
+        "den(z) = 1 -",
         "poles:",
         "stable",
         "D = lambda_max",

@@ -439,7 +439,7 @@ class LinearModel:
     def infer_input(
         self, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
     ) -> np.ndarray:
-        """The input that explains a measured output (SISO): ``u = (A y - k) / B``.
+        """The input that explains a measured output (SISO): ``u = (den y - intercept) / num``.
 
         This is the paper's estimated torque command (Figs. 13-14).
 
@@ -450,7 +450,7 @@ class LinearModel:
         y_init : array_like, shape (na,), optional
             Outputs before ``y[0]`` (oldest first). Default: ``y[0]`` repeated (rest).
         allow_unstable : bool
-            Compute even when ``B(z)`` has zeros outside the unit circle (the inverse
+            Compute even when ``num(z)`` has zeros outside the unit circle (the inverse
             then diverges); default raises :class:`ModelError`.
 
         Returns
@@ -490,7 +490,7 @@ class LinearModel:
 
         return signal.dlti(num, den, dt=self.dt)
 
-    def to_control(self, *, include_offset: bool = True) -> Any:
+    def to_control(self, *, include_offset: bool = False) -> Any:
         """Export as a python-control ``StateSpace`` system with the channel names.
 
         Each output equation is realised in observer canonical form (its inputs share the
@@ -501,18 +501,20 @@ class LinearModel:
         Parameters
         ----------
         include_offset : bool
-            Add an input named ``"offset"`` (last) through which the constant
-            ``intercept_j`` enters output ``j`` as ``intercept_j / A_j(z)``. Driven with
-            ones, ``control.forced_response`` equals :meth:`simulate` (zero initial
-            conditions, offset included). ``False`` exports the deviation model (the
-            ``n_inputs`` inputs only, like ``simulate(..., include_offset=False)``).
+            ``False`` (default): the system from the inputs alone, ``G = num/den`` per
+            channel (the deviation model, like ``simulate(..., include_offset=False)``), so
+            ``control.dcgain`` and ``control.step_response`` are ``n_outputs x n_inputs``
+            and equal :meth:`dc_gain` and the model's step. ``True`` adds an input named
+            ``"offset"`` (last) through which the constant ``intercept_j`` enters output
+            ``j`` as ``intercept_j / A_j(z)``: driven with ones, ``control.forced_response``
+            equals :meth:`simulate` (zero initial conditions, offset included).
 
         Returns
         -------
         control.StateSpace
             Inputs named after :attr:`input_names` (and ``"offset"``), outputs after
             :attr:`output_names`, ``dt`` the sample time [s]. Needs the optional
-            dependency ``control`` (``pip install clpc[control]``).
+            dependency ``control`` (``pip install ".[control]"`` from the source tree).
         """
         try:
             import control

@@ -18,9 +18,9 @@ from clpc.model.errors import ModelError, as_2d
 
 __all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
 
-#: Values of ``info["noise_model"]``: ``"equation-error"`` (``A y = B u + e``, white ``e``:
+#: Values of ``info["noise_model"]``: ``"equation-error"`` (``den y = num u + e``, white ``e``:
 #: LPC, least squares; the default when the key is absent) and ``"output-error"``
-#: (``y = B/A u + e``, white ``e``: :class:`clpc.OE`).
+#: (``y = num/den u + e``, white ``e``: :class:`clpc.OE`).
 NOISE_MODELS = ("equation-error", "output-error")
 
 
@@ -229,13 +229,14 @@ def infer_input(
     num = model.num[s.nk :]
     if abs(num[0]) <= 1e-9 * max(np.max(np.abs(num)), 1e-300):
         raise ModelError(
-            f"b0 is about 0 (numerator {num.round(9).tolist()}): the current input does "
-            "not reach the output after nk samples; increase nk by one and refit."
+            f"b0 is about 0 (num(z) after its nk leading zeros: {num.round(9).tolist()}): the "
+            "current input does not reach the output after nk samples; increase nk by one and "
+            "refit."
         )
     zeros = np.roots(num) if num.size > 1 else np.array([])
     if zeros.size and np.max(np.abs(zeros)) >= 1.0 and not allow_unstable:
         raise ModelError(
-            f"the inverse model is unstable: B(z) has zeros {np.round(zeros, 4).tolist()} "
+            f"the inverse model is unstable: num(z) has zeros {np.round(zeros, 4).tolist()} "
             "on or outside the unit circle (a non-minimum-phase model). Pass "
             "allow_unstable=True to compute it anyway."
         )
