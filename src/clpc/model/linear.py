@@ -520,7 +520,8 @@ class LinearModel:
             import control
         except ImportError:  # pragma: no cover - depends on the environment
             raise ImportError(
-                "to_control() needs python-control: pip install 'clpc[control]'"
+                "to_control() needs python-control: pip install control (or, in the clpc "
+                "source tree, pip install '.[control]')"
             ) from None
         blocks = []
         for j in range(self.n_outputs):
