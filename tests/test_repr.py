@@ -37,10 +37,8 @@ PACKAGES = (
 )
 
 #: public dataclasses that are settings or specifications written by the user, not results
+#: (estimators, the dataclasses with a ``fit`` method, are settings too)
 NOT_RESULTS = {
-    "ARX",
-    "LPC",
-    "OE",
     "RobustRule",
     "Structure",
     "Dataset",
@@ -63,7 +61,7 @@ def _public_dataclasses() -> set[str]:
         module = importlib.import_module(package)
         for name in module.__all__:
             obj = getattr(module, name)
-            if inspect.isclass(obj) and dataclasses.is_dataclass(obj):
+            if inspect.isclass(obj) and dataclasses.is_dataclass(obj) and not hasattr(obj, "fit"):
                 names.add(obj.__name__)
     return names
 
