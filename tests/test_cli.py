@@ -80,7 +80,7 @@ def test_identify_text_on_shipped_record():
     args = ("--estimator", "lpc", "--order", "2", "--nk", "0")
     out = ok("identify", DRYER, "--input", "u", "--output", "y", "--dt", "0.08", *args).output
     for word in (
-        "A(z) = 1 -",
+        "den(z) = 1 -",
         "poles:",
         "stable",
         "D = lambda_max",

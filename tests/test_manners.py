@@ -102,11 +102,32 @@ def _coefficients(line: str) -> list[float]:
 
 def test_repr_shows_the_coefficients(siso):
     lines = repr(siso).splitlines()
-    a_line = next(line for line in lines if "A(z) =" in line)
-    b_line = next(line for line in lines if "B(z) =" in line)
+    a_line = next(line for line in lines if "den(z) =" in line)
+    b_line = next(line for line in lines if "num(z) =" in line)
     np.testing.assert_allclose(_coefficients(a_line), siso.den, rtol=1e-5)  # 6 digits shown
     np.testing.assert_allclose(_coefficients(b_line), siso.num[siso.num != 0], rtol=1e-5)
     assert f"offset {siso.intercept[0]:.6g}" in repr(siso) and "(stable;" in repr(siso)
+
+
+def test_one_naming_of_the_transfer_function_everywhere(siso):
+    """repr, notebook table, summary() and the CLI text all say num(z)/den(z), never B(z)."""
+    from clpc.model.uncertainty import parameter_labels, parameter_vector
+
+    summary = report.model_summary(siso)
+    shown = [
+        repr(siso),
+        _parsed_text(siso._repr_html_()),
+        siso.summary(),
+        report.format_model_summary(summary),
+    ]
+    for text in shown:
+        assert "num(z)" in text and "den(z)" in text
+        assert "B(z) =" not in text and "numerator" not in text and "A(z) =" not in text
+    # the parameters are the coefficients of num and den, named so
+    values = dict(zip(parameter_labels(siso), parameter_vector(siso)[0], strict=True))
+    assert values["den1"] == siso.den[1] and values["num0[u]"] == siso.num[0]
+    printed = {p["name"]: p["value"] for p in summary["equations"][0]["parameters"]}
+    assert printed["den2"] == siso.den[2] and printed["num1[u]"] == siso.num[1]
 
 
 def test_repr_of_a_model_without_monic_form():

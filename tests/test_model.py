@@ -205,7 +205,7 @@ def test_infer_input_refuses_non_minimum_phase(make_model):
     y = model.simulate(np.random.default_rng(24).standard_normal(100))
     with pytest.raises(
         ModelError,
-        match=r"the inverse model is unstable: B\(z\) has zeros "
+        match=r"the inverse model is unstable: num\(z\) has zeros "
         r"\[-5\.0\] on or outside the unit circle",
     ):
         model.infer_input(y)
@@ -358,8 +358,9 @@ def test_to_scipy_with_na_less_than_nb(make_model):
 
 def test_to_control_poles_and_dcgain(model_delay):
     control = pytest.importorskip("control")
-    sys = model_delay.to_control(include_offset=False)
-    assert sys.dt == 0.01 and sys.ninputs == 1
+    sys = model_delay.to_control()  # the inputs alone by default: a 1x1 system
+    assert sys.dt == 0.01 and (sys.noutputs, sys.ninputs) == (1, 1)
+    assert np.shape(control.dcgain(sys)) == ()
     # the padded export may add poles at z = 0 (pure delays); the others are the model's
     poles = np.asarray(sys.poles())
     nonzero = poles[np.abs(poles) > 1e-9]
@@ -390,8 +391,8 @@ def _stable_miso():
 def test_to_control_mimo():
     pytest.importorskip("control")
     miso = _stable_miso()
-    sys = miso.to_control(include_offset=False)
-    assert (sys.noutputs, sys.ninputs) == (2, 2)
+    sys = miso.to_control()
+    assert (sys.noutputs, sys.ninputs) == (2, 2) and sys.input_labels == ["left", "right"]
     gain = np.asarray(sys.dcgain()).reshape(2, 2)
     np.testing.assert_allclose(gain, miso.dc_gain(), rtol=1e-10)
 
@@ -401,7 +402,7 @@ def test_to_control_keeps_names_and_offset(which, model_delay):
     control = pytest.importorskip("control")
     model = _stable_miso() if which == "miso" else model_delay
     model = replace(model, c=model.c + 0.25)  # a nonzero offset for both
-    sys = model.to_control()
+    sys = model.to_control(include_offset=True)
     assert sys.input_labels == [*model.input_names, "offset"]
     assert sys.output_labels == list(model.output_names)
     n = 80
@@ -410,10 +411,8 @@ def test_to_control_keeps_names_and_offset(which, model_delay):
     np.testing.assert_allclose(
         np.atleast_2d(resp.outputs).T, model.simulate(u).reshape(n, -1), rtol=1e-10, atol=1e-12
     )
-    # without the offset input: the deviation model
-    dev = control.forced_response(
-        model.to_control(include_offset=False), np.arange(n) * model.dt, u.T
-    )
+    # without the offset input (the default): the deviation model
+    dev = control.forced_response(model.to_control(), np.arange(n) * model.dt, u.T)
     np.testing.assert_allclose(
         np.atleast_2d(dev.outputs).T,
         model.simulate(u, include_offset=False).reshape(n, -1),

@@ -128,7 +128,7 @@ def test_oe_model_has_verdict_summary_and_simulation_residuals():
     text = str(verdict)
     assert "held-out fit" in text and "free run" in text and "residuals" in text
     summary = model.summary()
-    assert "y = B(z)/A(z) u + e" in summary and "+-" in summary
+    assert "y = num(z)/den(z) u + e" in summary and "+-" in summary
     assert clpc.residual_analysis(model, u, y).kind == "simulation"
 
 
@@ -261,7 +261,7 @@ def test_cli_names_the_estimator_in_the_summary_and_the_report(tmp_path):
     res = CliRunner().invoke(cli, [*args, "--estimator", "oe", "--report", str(tmp_path / "r")])
     assert res.exit_code == 0, res.output
     assert "\nOE (output error) model  na=2 nb=2 nk=3  method=output-error" in res.output
-    assert "parameters (+- 1 sigma): a1" in res.output  # the OE covariance reaches the CLI
+    assert "parameters (+- 1 sigma): den1" in res.output  # the OE covariance reaches the CLI
     html = (tmp_path / "r" / "report.html").read_text()
     assert "identify report (OE (output error) model)" in html
     plain = CliRunner().invoke(cli, [*args, "--estimator", "lpc"])

@@ -189,7 +189,7 @@ def test_identify_report_shows_verdict_uncertainty_and_residuals(tmp_path):
     res = CliRunner().invoke(cli, args)
     assert res.exit_code == 0, res.output
     assert f"wrote {out / 'report.html'}" in res.output
-    assert "residual tests" in res.output and "parameters (+- 1 sigma): a1" in res.output
+    assert "residual tests" in res.output and "parameters (+- 1 sigma): den1" in res.output
     page = (out / "report.html").read_text()
     for heading in ("Result: the model", "Parameters and their uncertainty", "Residual analysis"):
         assert f"<h2>{heading}</h2>" in page

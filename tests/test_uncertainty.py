@@ -219,7 +219,7 @@ def test_summary_shows_coefficients_with_sigma():
     text = m.summary()
     sigma = np.sqrt(np.diag(m.covariance[0]))
     assert "block jackknife over 20 segments" in text
-    assert f"a1           {m.den[1]: .6g} +- {sigma[0]:.3g}" in text
+    assert f"den1         {m.den[1]: .6g} +- {sigma[0]:.3g}" in text
     assert "pole 1" in text and "DC gain u -> y" in text
 
 

@@ -7,6 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
+from clpc.data.signals import signals
+
 __all__ = ["fit_percent", "kstep_fit", "rmse", "vaf", "whiteness_test"]
 
 
@@ -98,7 +101,7 @@ def vaf(y: Any, y_hat: Any) -> Any:
     return _out(out, one)
 
 
-def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
+def kstep_fit(model: Any, u: Any, y: Any = None, k: int = 1) -> Any:
     """Fit % of the ``k``-step-ahead prediction (skips the first ``max_lag + k - 1`` samples).
 
     For integrating plants (a motor from torque to position) a free-run simulation drifts
@@ -108,10 +111,11 @@ def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
     ----------
     model : LinearModel
         The model whose :meth:`~clpc.LinearModel.predict` is scored.
-    u : array_like, shape (T,) or (T, n_inputs)
-        Input samples.
+    u : array_like, shape (T,) or (T, n_inputs), or IOData
+        Input samples, or a record of one experiment (its inputs and outputs; then give
+        ``k`` by keyword).
     y : array_like, shape (T,) or (T, n_outputs)
-        Measured outputs (predicted from and scored against).
+        Measured outputs (predicted from and scored against; required with array inputs).
     k : int
         Prediction horizon in samples (>= 1, default 1).
 
@@ -120,6 +124,7 @@ def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
     float or ndarray, shape (n_outputs,)
         Fit % (:func:`fit_percent`): a float for 1-D ``y``, else one per output.
     """
+    u, y = signals(u, y, what="kstep_fit")
     y_arr = np.asarray(y, dtype=np.float64)
     y_hat = model.predict(u, y_arr, k=k)
     # the first k - 1 predictions after max_lag still lean on measured outputs newer than
@@ -129,6 +134,7 @@ def kstep_fit(model: Any, u: Any, y: Any, k: int = 1) -> Any:
     return fit_percent(y_arr[start:], y_hat[start:])
 
 
+@compact_repr
 @dataclass(frozen=True)
 class WhitenessResult:
     """Ljung-Box portmanteau test of residual whiteness."""

@@ -31,6 +31,8 @@ from clpc.appraiser.spread import (
     level_trend,
     window_dc_gains,
 )
+from clpc.core.compact import compact_repr
+from clpc.data.signals import signals
 from clpc.lpc.arx import ARX
 
 __all__ = [
@@ -80,6 +82,7 @@ def locality(window_ops: np.ndarray, samples: np.ndarray) -> float:
     return float(np.std(window_ops) / s) if s > 0 else 0.0
 
 
+@compact_repr
 @dataclass(frozen=True)
 class OperatingPointReport:
     """Operating-point diagnostics of a trace (one entry per window where arrays).
@@ -135,7 +138,7 @@ def _one_step_error(reference: Any, u: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def operating_point_diagnostics(
-    trace: Any, u: Any, y: Any, reference: Any = None
+    trace: Any, u: Any, y: Any = None, reference: Any = None
 ) -> OperatingPointReport:
     """Compare the windows of a SISO trace across operating points.
 
@@ -144,7 +147,8 @@ def operating_point_diagnostics(
     trace : clpc.Trace
         From ``CLPC.run(u, y)`` at the record's own sample time (no decimation).
     u, y : array_like, shape (T,)
-        The record the trace was computed on.
+        The record the trace was computed on; or an IOData of one experiment in the place
+        of ``u`` (then ``y`` is left out).
     reference : LinearModel, optional
         The global model to test; default least squares (:class:`clpc.ARX`) of the
         trace's structure on the whole record.
@@ -153,6 +157,7 @@ def operating_point_diagnostics(
     -------
     OperatingPointReport
     """
+    u, y = signals(u, y, what="operating_point_diagnostics")
     uu = np.asarray(u, dtype=np.float64).ravel()
     yy = np.asarray(y, dtype=np.float64).ravel()
     if trace.n_equations != 1 or trace.n_inputs != 1:

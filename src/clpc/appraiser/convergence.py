@@ -19,11 +19,13 @@ from clpc.appraiser.spread import (
     level_trend,
     window_dc_gains,
 )
+from clpc.core.compact import compact_repr
 from clpc.model import LinearModel
 
 __all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model", "usable"]
 
 
+@compact_repr
 @dataclass(frozen=True)
 class Convergence:
     """When the appraiser's outputs became quasi-constant.

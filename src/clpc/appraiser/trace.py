@@ -14,6 +14,7 @@ import numpy as np
 from clpc.appraiser import convergence
 from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION, Convergence
 from clpc.appraiser.convergence import steady_state_model as steady_state
+from clpc.core.compact import compact_repr
 from clpc.model import LinearModel
 from clpc.model.structure import Structure
 
@@ -44,6 +45,7 @@ SCALAR_KEYS = (
 PER_EQUATION = ("theta", "theta_estimate", "den", "num", "eigenvalues", *SCALAR_KEYS)
 
 
+@compact_repr
 @dataclass(frozen=True, eq=False)
 class Trace:
     """Per-update record of a CLPC run (one row per cluster update).

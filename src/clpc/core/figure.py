@@ -1,7 +1,8 @@
 """Figure primitives shared by every plot: Agg figures, colours per quantity, envelopes.
 
 Kept at the bottom layer so that :meth:`clpc.IOData.plot` and :mod:`clpc.plotting` draw
-alike. matplotlib is imported only when a figure is made (``pip install 'clpc[plot]'``).
+alike. matplotlib is imported only when a figure is made (``pip install '.[plot]'`` in the
+source tree).
 
 * :data:`COLORS` - one colour per quantity (measured, model output, residual, ...), the
   same in every figure.
@@ -36,7 +37,10 @@ __all__ = [
     "time_label",
 ]
 
-INSTALL_HINT = "plotting needs matplotlib: pip install 'clpc[plot]'"
+INSTALL_HINT = (
+    "plotting needs matplotlib: pip install matplotlib (or, in the clpc source tree, "
+    "pip install '.[plot]')"
+)
 
 #: the colour of each quantity, the same in every figure
 COLORS: dict[str, str] = {

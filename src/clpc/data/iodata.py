@@ -9,13 +9,16 @@ lag vectors inside each experiment, never across a boundary.
 
 from __future__ import annotations
 
+import html
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import html_table, summarise
 from clpc.data import processing
+from clpc.data.timebase import DEFAULT_TIME_RTOL
 from clpc.data.validation import (
     DataError,
     channel_names,
@@ -139,11 +142,22 @@ class IOData:
         return self._with(self.u[index], self.y[index], experiments=parts)
 
     def __repr__(self) -> str:
-        more = f", experiments={list(self.experiments)}" if self.n_experiments > 1 else ""
-        return (
-            f"IOData(n_samples={self.n_samples}, inputs={list(self.input_names)}, "
-            f"outputs={list(self.output_names)}, dt={self.dt:g}{more})"
+        more = (
+            f", experiments={summarise(list(self.experiments))}" if self.n_experiments > 1 else ""
         )
+        return (
+            f"IOData(n_samples={self.n_samples}, inputs={summarise(list(self.input_names))}, "
+            f"outputs={summarise(list(self.output_names))}, dt={self.dt:g}{more})"
+        )
+
+    def _repr_html_(self) -> str:
+        """The record as an HTML table (Jupyter): sample time, experiments, every channel."""
+        rows = [("samples", str(self.n_samples)), ("dt [s]", f"{self.dt:g}")]
+        if self.n_experiments > 1:
+            rows.append(("experiments", html.escape(summarise(list(self.experiments)))))
+        for names, values in ((self.input_names, self.u), (self.output_names, self.y)):
+            rows += [(n, html.escape(summarise(values[:, i]))) for i, n in enumerate(names)]
+        return html_table("IOData", rows)
 
     def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> IOData:
         """A new record with these samples and this record's names."""
@@ -273,14 +287,9 @@ class IOData:
     # ------------------------------------------------------------ DataFrames
     def to_frame(self) -> Any:
         """A pandas DataFrame: ``time`` [s], the inputs, the outputs (and ``experiment``)."""
-        import pandas as pd
+        from clpc.data.frames import to_frame
 
-        columns: dict[str, Any] = {"time": self.time}
-        if self.n_experiments > 1:
-            columns["experiment"] = np.repeat(np.arange(self.n_experiments), self.experiments)
-        columns.update(zip(self.input_names, self.u.T, strict=True))
-        columns.update(zip(self.output_names, self.y.T, strict=True))
-        return pd.DataFrame(columns)
+        return to_frame(self)
 
     @classmethod
     def from_frame(
@@ -290,8 +299,18 @@ class IOData:
         outputs: str | Sequence[str],
         dt: float | None = None,
         experiment: str | None = None,
+        *,
+        time_column: str | None = None,
+        time_unit: str | None = None,
+        time_rtol: float = DEFAULT_TIME_RTOL,
+        resample: bool = False,
     ) -> IOData:
         """A record from DataFrame columns; :meth:`to_frame` round-trips.
+
+        The sample time comes from ``time_column``, else from a column named ``time``, else
+        from a ``DatetimeIndex`` or ``TimedeltaIndex``, else from ``dt`` (default 1). Sample
+        times must step uniformly in each experiment, by the rule of the file readers
+        (:func:`clpc.data.timebase.check_time_base`).
 
         Parameters
         ----------
@@ -300,34 +319,47 @@ class IOData:
         inputs, outputs : str or sequence of str
             Names of the input and output columns (also the channel names).
         dt : float, optional
-            Sample time [s]; default the ``time`` column's mean step (in the first
-            experiment) when the frame has one, else 1.
+            Sample time [s]. With sample times in the frame it must agree with their step
+            (within ``time_rtol``); with ``resample`` it is the grid step.
         experiment : str, optional
             A column labelling the experiments; each change of label starts a new one.
+        time_column : str, optional
+            A column of sample times: numbers (in ``time_unit``) or dates/durations.
+        time_unit : {"s", "ms", "us"}, optional
+            Unit of a numeric time column; default the one its name says (``t_ms`` is in
+            milliseconds), else seconds.
+        time_rtol : float
+            Largest relative deviation of one step from the median step (default 1e-2, as
+            :func:`clpc.io.load_iodata`).
+        resample : bool
+            Interpolate each experiment onto the uniform grid ``t0 + k dt`` (linear)
+            instead of refusing sample times that are not uniform.
 
         Returns
         -------
         IOData
+
+        Raises
+        ------
+        DataError
+            A missing column; sample times that are not numbers or dates, not increasing or
+            not uniform; a ``dt`` or an experiment whose step disagrees with the first.
         """
-        ins = [inputs] if isinstance(inputs, str) else list(inputs)
-        outs = [outputs] if isinstance(outputs, str) else list(outputs)
-        missing = [
-            c for c in (*ins, *outs, *([experiment] if experiment else [])) if c not in frame
-        ]
-        if missing:
-            raise DataError(
-                f"columns {missing} are not in the frame; it has {list(frame.columns)}."
+        from clpc.data.frames import from_frame
+
+        return cls(
+            *from_frame(
+                frame,
+                inputs,
+                outputs,
+                dt,
+                experiment,
+                time_column=time_column,
+                time_unit=time_unit,
+                time_rtol=time_rtol,
+                resample=resample,
             )
-        parts = None
-        if experiment is not None:
-            labels = np.asarray(frame[experiment])
-            change = np.flatnonzero(labels[1:] != labels[:-1]) + 1
-            parts = np.diff([0, *change, labels.size]).tolist()
-        if dt is None and "time" in frame and len(frame) > 1:
-            t = np.asarray(frame["time"], dtype=np.float64)
-            first = t[: parts[0]] if parts else t
-            dt = float((first[-1] - first[0]) / (first.size - 1)) if first.size > 1 else None
-        return cls(frame[ins], frame[outs], 1.0 if dt is None else dt, ins, outs, parts)
+        )
 
     def plot(self, path: Any = None, *, title: str | None = None, ax: Any = None) -> Any:
         """Plot every channel against time (needs matplotlib).

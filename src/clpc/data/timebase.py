@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.data.iodata import DataError
+from clpc.data.validation import DataError
 
 __all__ = [
     "DEFAULT_TIME_RTOL",

@@ -60,7 +60,7 @@ def _check_format(d: dict[str, Any], check: Fields) -> None:
     if version > SCHEMA_VERSION:
         raise check.fail(
             f"schema_version {version} is newer than this clpc reads ({SCHEMA_VERSION}); "
-            "upgrade clpc (pip install -U clpc) to load it.",
+            "upgrade clpc (pip install . in a newer clpc source tree) to load it.",
         )
 
 

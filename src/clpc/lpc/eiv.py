@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.data import IOData
 from clpc.lpc.estimator import LPC
 from clpc.lpc.regressors import regressors
@@ -48,6 +49,7 @@ RATIO = 5.0
 MIN_RELATIVE = 0.05
 
 
+@compact_repr
 @dataclass(frozen=True)
 class EivCheck:
     """Evidence on the errors-in-variables assumption of LPC.

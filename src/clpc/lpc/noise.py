@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.data import DataError, as_iodata
 from clpc.lpc.regressors import Structure, siso_regressor
 
@@ -35,6 +36,7 @@ RATIO_AGREEMENT = 2.0
 VARIANCE_FLOOR = 1e-12
 
 
+@compact_repr
 @dataclass(frozen=True)
 class NoiseEstimate:
     """Estimated white-noise variances of a SISO record, and whether to believe them.

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.data import as_iodata
 from clpc.lpc import heldout
 from clpc.lpc.estimator import LPC
@@ -24,6 +25,7 @@ def candidate_settings(estimator: Any) -> Any:
     return replace(estimator, **quick)
 
 
+@compact_repr
 @dataclass(frozen=True)
 class OrderSelection:
     """Table of criteria per order and the chosen order.
@@ -226,6 +228,7 @@ def _by_validation(
     )
 
 
+@compact_repr
 @dataclass(frozen=True)
 class DelaySelection:
     """Held-out ``k``-step fit % per input delay and the chosen delay.

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from clpc.core.checks import check_choice, check_int
+from clpc.core.compact import compact_repr
 from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
 from clpc.lpc.choice import GUARD, choose, guarded, oe_lead, tier
@@ -75,6 +76,7 @@ __all__ = ["ESTIMATORS", "Identification", "identify", "pct"]
 ESTIMATORS = ("auto", "lpc", "arx", "oe")
 
 
+@compact_repr
 @dataclass(frozen=True)
 class Identification:
     """The outcome of :func:`identify`.

@@ -70,7 +70,7 @@ def poly_text(coefs: Sequence[float], var: str = "z^-1") -> str:
 
 
 def _equations(model: Any) -> list[dict[str, Any]]:
-    """Per output: name, ``A(z)``, ``{input: numerator}``, offset, poles, statistics."""
+    """Per output: name, ``den(z)``, ``{input: num(z)}``, offset, poles, statistics."""
     try:
         dens, nums, icpt = model.denominators, model.numerators, model.intercept
     except ValueError:  # ModelError: a0 about 0, no monic form
@@ -111,8 +111,10 @@ def _stat_text(key: str, value: Any) -> str:
 def model_repr(model: Any) -> str:
     """``repr`` of a model: its structure, then one line per transfer function.
 
-    The coefficients are those of the monic engineering convention (``y = num/den u +
-    offset/den``); a model without a monic form (``a0`` about 0) shows ``theta`` instead.
+    The coefficients are those of the engineering transfer function ``G(z) = num(z)/den(z)``
+    (``den = A/a0`` monic, ``num = -z^-nk B/a0`` of the paper's ``theta = [a; b]``; ``y =
+    num/den u + offset/den``); a model without a monic form (``a0`` about 0) shows ``theta``
+    instead.
     """
     s = model.structure
     head = (
@@ -125,14 +127,15 @@ def model_repr(model: Any) -> str:
     lines = [head]
     for eq in eqs:
         out = eq["output"]
-        lines.append(f"  {out}: A(z) = {eq['den']}")
+        lines.append(f"  {out}: den(z) = {eq['den']}")
         for inp, num in eq["num"].items():
-            lines.append(f"  {inp} -> {out}: B(z) = {num}")
+            lines.append(f"  {inp} -> {out}: num(z) = {num}")
         if eq["offset"]:
             lines.append(f"  {out}: offset {eq['offset']:.6g}")
         if eq["stats"]:
             lines.append(f"  {out}: " + "  ".join(_stat_text(k, v) for k, v in eq["stats"].items()))
-    lines.append(f"  ({_stability_words(model)}; G(z) = B(z)/A(z), powers of z^-1)")
+    words = _stability_words(model)
+    lines.append(f"  ({words}; G(z) = num(z)/den(z) = -B(z)/A(z), powers of z^-1)")
     return "\n".join(lines)
 
 
@@ -174,7 +177,7 @@ def model_html(model: Any) -> str:
                 f"<td>{stats or '&ndash;'}</td></tr>"
             )
     head = (
-        "<tr><th>channel</th><th>B(z)</th><th>A(z)</th><th>offset</th><th>poles</th>"
+        "<tr><th>channel</th><th>num(z)</th><th>den(z)</th><th>offset</th><th>poles</th>"
         "<th>stable</th><th>statistics</th></tr>"
     )
     if not eqs:

@@ -385,8 +385,10 @@ class LinearModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
-            Input samples.
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Input samples, or a record (its inputs; a record of several experiments is
+            simulated one experiment at a time, each from zero initial conditions, and
+            stacked).
         y_init : array_like, shape (na,) or (na, n_outputs), optional
             The ``na`` outputs just before ``u[0]``, oldest first. Default: zeros.
         u_init : array_like, shape (nk+nb,) or (nk+nb, n_inputs), optional
@@ -398,12 +400,13 @@ class LinearModel:
         Returns
         -------
         ndarray, shape (T,) for a SISO model given 1-D ``u``, else (T, n_outputs)
+            (a record's ``y`` shape).
         """
         return simulation.simulate(
             self, u, y_init=y_init, u_init=u_init, include_offset=include_offset
         )
 
-    def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
+    def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
 
         Each prediction uses measured outputs up to ``n - k`` and the model for the rest
@@ -418,32 +421,36 @@ class LinearModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Measured inputs, or a record (its inputs and outputs; then leave ``y`` out and
+            give ``k`` by keyword: ``predict(data, k=10)``). A record of several experiments
+            is predicted one experiment at a time, and stacked.
         y : array_like, shape (T,) or (T, n_outputs)
+            Measured outputs (required with array inputs).
         k : int
             Prediction horizon in samples (>= 1).
 
         Returns
         -------
-        ndarray, same shape as ``y``
+        ndarray, same shape as ``y`` (a record's ``y`` shape)
         """
         return simulation.predict(self, u, y, k)
 
     def infer_input(
         self, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
     ) -> np.ndarray:
-        """The input that explains a measured output (SISO): ``u = (A y - k) / B``.
+        """The input that explains a measured output (SISO): ``u = (den y - intercept) / num``.
 
         This is the paper's estimated torque command (Figs. 13-14).
 
         Parameters
         ----------
-        y : array_like, shape (T,)
-            Measured output.
+        y : array_like, shape (T,), or IOData
+            Measured output, or a record of one experiment (its output).
         y_init : array_like, shape (na,), optional
             Outputs before ``y[0]`` (oldest first). Default: ``y[0]`` repeated (rest).
         allow_unstable : bool
-            Compute even when ``B(z)`` has zeros outside the unit circle (the inverse
+            Compute even when ``num(z)`` has zeros outside the unit circle (the inverse
             then diverges); default raises :class:`ModelError`.
 
         Returns
@@ -483,7 +490,7 @@ class LinearModel:
 
         return signal.dlti(num, den, dt=self.dt)
 
-    def to_control(self, *, include_offset: bool = True) -> Any:
+    def to_control(self, *, include_offset: bool = False) -> Any:
         """Export as a python-control ``StateSpace`` system with the channel names.
 
         Each output equation is realised in observer canonical form (its inputs share the
@@ -494,24 +501,27 @@ class LinearModel:
         Parameters
         ----------
         include_offset : bool
-            Add an input named ``"offset"`` (last) through which the constant
-            ``intercept_j`` enters output ``j`` as ``intercept_j / A_j(z)``. Driven with
-            ones, ``control.forced_response`` equals :meth:`simulate` (zero initial
-            conditions, offset included). ``False`` exports the deviation model (the
-            ``n_inputs`` inputs only, like ``simulate(..., include_offset=False)``).
+            ``False`` (default): the system from the inputs alone, ``G = num/den`` per
+            channel (the deviation model, like ``simulate(..., include_offset=False)``), so
+            ``control.dcgain`` and ``control.step_response`` are ``n_outputs x n_inputs``
+            and equal :meth:`dc_gain` and the model's step. ``True`` adds an input named
+            ``"offset"`` (last) through which the constant ``intercept_j`` enters output
+            ``j`` as ``intercept_j / A_j(z)``: driven with ones, ``control.forced_response``
+            equals :meth:`simulate` (zero initial conditions, offset included).
 
         Returns
         -------
         control.StateSpace
             Inputs named after :attr:`input_names` (and ``"offset"``), outputs after
             :attr:`output_names`, ``dt`` the sample time [s]. Needs the optional
-            dependency ``control`` (``pip install clpc[control]``).
+            dependency ``control`` (``pip install ".[control]"`` from the source tree).
         """
         try:
             import control
         except ImportError:  # pragma: no cover - depends on the environment
             raise ImportError(
-                "to_control() needs python-control: pip install 'clpc[control]'"
+                "to_control() needs python-control: pip install control (or, in the clpc "
+                "source tree, pip install '.[control]')"
             ) from None
         blocks = []
         for j in range(self.n_outputs):

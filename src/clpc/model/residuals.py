@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
+from clpc.data.signals import signals
 from clpc.model.simulation import noise_models
 
 __all__ = ["MAX_LAGS", "ResidualAnalysis", "ResidualTest", "ljung_box", "residual_analysis"]
@@ -86,6 +88,7 @@ class ResidualTest:
         )
 
 
+@compact_repr
 @dataclass(frozen=True)
 class ResidualAnalysis:
     """Correlations of the residuals, their bands and the tests (see the module).
@@ -183,7 +186,7 @@ def _residuals(model: Any, u: np.ndarray, y: np.ndarray, kind: str) -> np.ndarra
 def residual_analysis(
     model: Any,
     u: Any,
-    y: Any,
+    y: Any = None,
     *,
     max_lag: int = MAX_LAGS,
     level: float = LEVEL,
@@ -195,10 +198,10 @@ def residual_analysis(
     ----------
     model : LinearModel
         The model.
-    u : array_like, shape (T,) or (T, n_inputs)
-        Measured inputs.
+    u : array_like, shape (T,) or (T, n_inputs), or IOData
+        Measured inputs, or a record of one experiment (its inputs and outputs).
     y : array_like, shape (T,) or (T, n_outputs)
-        Measured outputs.
+        Measured outputs (required with array inputs).
     max_lag : int
         ``M``, the lags tested (reduced to ``N // 4`` on short records).
     level : float
@@ -225,6 +228,7 @@ def residual_analysis(
         raise ValueError(f"level must be in (0, 1), e.g. 0.99; got {level!r}.")
     if isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer)) or max_lag < 1:
         raise ValueError(f"max_lag must be an int >= 1; got {max_lag!r}.")
+    u, y = signals(u, y, what="residual_analysis")
     u2 = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
     y2 = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
     if u2.shape[1] != model.n_inputs or y2.shape[1] != model.n_outputs or len(u2) != len(y2):

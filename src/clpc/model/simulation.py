@@ -6,18 +6,21 @@ The model's methods of the same names call these functions (``model`` is a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from clpc.core.filters import all_pole, fir
+from clpc.data import DataError, IOData
+from clpc.data.signals import signals
 from clpc.model.errors import ModelError, as_2d
 
 __all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
 
-#: Values of ``info["noise_model"]``: ``"equation-error"`` (``A y = B u + e``, white ``e``:
+#: Values of ``info["noise_model"]``: ``"equation-error"`` (``den y = num u + e``, white ``e``:
 #: LPC, least squares; the default when the key is absent) and ``"output-error"``
-#: (``y = B/A u + e``, white ``e``: :class:`clpc.OE`).
+#: (``y = num/den u + e``, white ``e``: :class:`clpc.OE`).
 NOISE_MODELS = ("equation-error", "output-error")
 
 
@@ -75,6 +78,12 @@ def simulate(
     include_offset: bool = True,
 ) -> np.ndarray:
     """Free-run simulation from the input alone (see :meth:`clpc.LinearModel.simulate`)."""
+    stacked = _by_experiment(
+        u, lambda part: simulate(model, part, include_offset=include_offset), y_init, u_init
+    )
+    if stacked is not None:
+        return stacked
+    u, _ = signals(u, what="simulate", needs_y=False)
     u2, was_1d = as_2d(u, model.n_inputs, "u")
     x = forced(model, u2, u_init)
     if include_offset:
@@ -93,7 +102,21 @@ def simulate(
     return y[:, 0] if (was_1d and model.n_outputs == 1) else y
 
 
-def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
+def _by_experiment(
+    data: Any, run: Callable[[IOData], np.ndarray], *initial: Any
+) -> np.ndarray | None:
+    """``run`` on each experiment of a record of several, stacked; ``None`` for others."""
+    if not (isinstance(data, IOData) and data.n_experiments > 1):
+        return None
+    if any(x is not None for x in initial):
+        raise DataError(
+            "initial conditions (y_init, u_init) are for one experiment; this record holds "
+            f"{data.n_experiments}: simulate them one at a time (data.split())."
+        )
+    return np.concatenate([run(part) for part in data.split()])
+
+
+def predict(model: Any, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
     """``k``-step-ahead prediction ``y_hat(n | n-k)`` (:meth:`clpc.LinearModel.predict`).
 
     Equation-error outputs: the recursion below (measured outputs up to ``n - k``, the
@@ -104,6 +127,11 @@ def predict(model: Any, u: Any, y: Any, k: int = 1) -> np.ndarray:
     """
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"k must be an int in the range [1, inf); got {k!r}.")
+    if y is None:
+        stacked = _by_experiment(u, lambda part: predict(model, part, k=k))
+        if stacked is not None:
+            return stacked
+    u, y = signals(u, y, what="predict")
     u2, _ = as_2d(u, model.n_inputs, "u")
     y2, y_1d = as_2d(y, model.n_outputs, "y")
     if u2.shape[0] != y2.shape[0]:
@@ -193,19 +221,22 @@ def infer_input(
 ) -> np.ndarray:
     """The input that explains a measured output (:meth:`clpc.LinearModel.infer_input`)."""
     model._siso("infer_input")
+    if isinstance(y, IOData):
+        y = signals(y, what="infer_input")[1]
     y2, _ = as_2d(y, 1, "y")
     yv = y2[:, 0]
     s = model.structure
     num = model.num[s.nk :]
     if abs(num[0]) <= 1e-9 * max(np.max(np.abs(num)), 1e-300):
         raise ModelError(
-            f"b0 is about 0 (numerator {num.round(9).tolist()}): the current input does "
-            "not reach the output after nk samples; increase nk by one and refit."
+            f"b0 is about 0 (num(z) after its nk leading zeros: {num.round(9).tolist()}): the "
+            "current input does not reach the output after nk samples; increase nk by one and "
+            "refit."
         )
     zeros = np.roots(num) if num.size > 1 else np.array([])
     if zeros.size and np.max(np.abs(zeros)) >= 1.0 and not allow_unstable:
         raise ModelError(
-            f"the inverse model is unstable: B(z) has zeros {np.round(zeros, 4).tolist()} "
+            f"the inverse model is unstable: num(z) has zeros {np.round(zeros, 4).tolist()} "
             "on or outside the unit circle (a non-minimum-phase model). Pass "
             "allow_unstable=True to compute it anyway."
         )

@@ -246,15 +246,22 @@ def frequency_response_std(
 
 
 def parameter_labels(model: Any) -> list[str]:
-    """Names of the entries of a row of :func:`parameter_vector`: ``a1``, ``b0[u]``..."""
-    labels = [f"a{k}" for k in range(1, model.structure.na + 1)]
+    """Names of the entries of a row of :func:`parameter_vector`: ``den1``, ``num0[u]``...
+
+    The coefficients of ``G(z) = num(z)/den(z)`` (``a`` and ``b`` name the paper's
+    ``theta``, see ``docs/method.md``).
+    """
+    labels = [f"den{k}" for k in range(1, model.structure.na + 1)]
     width = model.structure.nk + model.structure.nb + 1
-    return labels + [f"b{k}[{name}]" for name in model.input_names for k in range(width)]
+    return labels + [f"num{k}[{name}]" for name in model.input_names for k in range(width)]
 
 
 def _equation(model: Any) -> str:
     """The model's equation with its noise model (white ``e``)."""
-    forms = {"equation-error": "A(z) y = B(z) u + e", "output-error": "y = B(z)/A(z) u + e"}
+    forms = {
+        "equation-error": "den(z) y = num(z) u + e",
+        "output-error": "y = num(z)/den(z) u + e",
+    }
     kinds = noise_models(model)
     if len(set(kinds)) == 1:
         return forms[kinds[0]]
@@ -277,7 +284,7 @@ def summary(model: Any) -> str:
         sigma, gain_std, how = np.full(theta.shape, np.nan), None, str(exc)
     lines = [
         f"{model!r}",
-        f"{_equation(model)}, monic A, coefficient k of z^-k; {how}",
+        f"{_equation(model)}, monic den, coefficient k of z^-k; {how}",
     ]
     gains = model.dc_gain()
     for j, name in enumerate(model.output_names):

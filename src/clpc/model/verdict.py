@@ -21,12 +21,14 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.core.polynomials import pole_class, pole_words
 from clpc.core.rules import MIN_HELDOUT_FIT
 
 __all__ = ["Verdict", "describe_trace", "fit_verdict"]
 
 
+@compact_repr
 @dataclass(frozen=True)
 class Verdict:
     """Identifiability of one fitted equation.

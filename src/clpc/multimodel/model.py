@@ -17,11 +17,14 @@ and their stability guard: :mod:`clpc.multimodel.local`; saving: :mod:`clpc.mult
 
 from __future__ import annotations
 
+import html
 from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import html_table, summarise
 from clpc.data import as_iodata
+from clpc.data.signals import signals
 from clpc.model import LinearModel
 from clpc.model.errors import as_2d
 from clpc.model.structure import Structure
@@ -235,7 +238,8 @@ class MultiModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Input samples, or a record of one experiment (its inputs).
         y_init : array_like, optional
             Outputs before ``u[0]``, oldest first (at least ``na``; more are used only by a
             schedule on an older lag). Default zeros.
@@ -248,7 +252,7 @@ class MultiModel:
         """
         f = self._require()
         sched = self._schedule()
-        u2, _ = as_2d(u, self.n_inputs, "u")
+        u2, _ = as_2d(signals(u, what="simulate", needs_y=False)[0], self.n_inputs, "u")
         s = self.structure
         pad = max(s.na, s.nk + s.nb, sched.lag, 1)
         y_ext = np.zeros(pad + u2.shape[0])
@@ -266,7 +270,7 @@ class MultiModel:
             blend_run(arrays, f.centres, f.widths, sched, u_ext, y_ext, pad)
         return y_ext[pad:]
 
-    def predict(self, u: Any, y: Any, k: int = 1) -> np.ndarray:
+    def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data (vectorised).
 
         The first ``max(max_lag, schedule lag)`` samples are returned as measured; each
@@ -274,10 +278,11 @@ class MultiModel:
 
         Parameters
         ----------
-        u : array_like, shape (T,) or (T, n_inputs)
-            Input samples.
+        u : array_like, shape (T,) or (T, n_inputs), or IOData
+            Input samples, or a record of one experiment (then leave ``y`` out and give
+            ``k`` by keyword).
         y : array_like, shape (T,)
-            Measured output.
+            Measured output (required with array inputs).
         k : int
             Prediction horizon in samples (>= 1, default 1).
 
@@ -289,6 +294,7 @@ class MultiModel:
             raise ValueError(f"k must be an int >= 1; got {k!r}.")
         f = self._require()
         sched = self._schedule()
+        u, y = signals(u, y, what="predict")
         u2, _ = as_2d(u, self.n_inputs, "u")
         y1 = np.asarray(y, dtype=np.float64).ravel()
         if u2.shape[0] != y1.shape[0]:
@@ -388,3 +394,11 @@ class MultiModel:
         s = self.structure
         m = "unfitted" if self._fitted is None else f"n_models={self.n_models}"
         return f"MultiModel(na={s.na}, nb={s.nb}, nk={s.nk}, {m}, schedule={self.schedule_spec!r})"
+
+    def _repr_html_(self) -> str:
+        """The multi-model as an HTML table (Jupyter): its validity functions, its models."""
+        rows = [("multi-model", html.escape(repr(self)))]
+        if self._fitted is not None:
+            rows += [(n, html.escape(summarise(getattr(self, n)))) for n in ("centres", "widths")]
+            rows += [(f"model {i}", m._repr_html_()) for i, m in enumerate(self.local_models)]
+        return html_table("MultiModel", rows)

@@ -4,8 +4,8 @@ Every function draws on the caller's matplotlib axes (``ax=``) or on a fresh
 :class:`matplotlib.figure.Figure` rendered by the Agg backend (no window opens, no global
 pyplot state changes, works on servers and in threads), returns the figure (Jupyter shows
 it) and also writes it as PNG when given a ``path``. matplotlib is an optional dependency
-(``pip install 'clpc[plot]'``), imported only when a figure is drawn. The same quantity
-has the same colour in every figure (:data:`clpc.core.figure.COLORS`); records longer than
+(``pip install '.[plot]'`` in the source tree), imported only when a figure is drawn. The same
+quantity has the same colour in every figure (:data:`clpc.core.figure.COLORS`); records longer than
 :data:`clpc.core.figure.MAX_POINTS` samples are drawn as min/max envelopes.
 
 >>> import clpc, clpc.datasets as ds                                  # doctest: +SKIP

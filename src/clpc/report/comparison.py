@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.compact import compact_repr
 from clpc.data import IOData
 from clpc.model import LinearModel
 from clpc.report.summaries import model_response
@@ -19,6 +20,7 @@ from clpc.report.text import format_fit
 __all__ = ["Comparison", "compare"]
 
 
+@compact_repr
 @dataclass(frozen=True, eq=False)
 class Comparison:
     """A model's output on a record beside the measured one (see :func:`compare`).

@@ -81,14 +81,14 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
         ),
         f"inputs: {', '.join(summary['inputs'])}   outputs: {', '.join(summary['outputs'])}"
         + (f"   samples: {summary['n_samples']}" if "n_samples" in summary else ""),
-        "transfer functions G(z) = numerator/A(z), monic A, powers of z^-1 "
-        "(numerator = -B(z) of the paper's theta = [a; b]):",
+        "transfer functions G(z) = num(z)/den(z) = -B(z)/A(z), den monic, powers of z^-1 "
+        "(A, B: the paper's theta = [a; b]):",
     ]
     for j, eq in enumerate(summary["equations"]):
         out = eq["output"]
-        lines.append(f"  [{out}]  A(z) = {poly_text(eq['den'])}")
+        lines.append(f"  [{out}]  den(z) = {poly_text(eq['den'])}")
         for inp, num in eq["num"].items():
-            lines.append(f"  [{out}]  {inp} -> {out}:  numerator {poly_text(num)}")
+            lines.append(f"  [{out}]  {inp} -> {out}:  num(z) = {poly_text(num)}")
         if eq["intercept"]:
             lines.append(f"  [{out}]  offset (intercept) {eq['intercept']:.6g}")
         poles = ", ".join(_fmt_complex(re, im) for re, im in eq["poles"])

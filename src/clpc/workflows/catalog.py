@@ -6,10 +6,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from clpc import datasets as _datasets
+from clpc.core.compact import compact_repr
 
 __all__ = ["DatasetEntry", "list_datasets"]
 
 
+@compact_repr
 @dataclass(frozen=True)
 class DatasetEntry:
     """One shipped record (see :mod:`clpc.datasets`).

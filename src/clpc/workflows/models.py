@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from clpc.core.checks import check_int
+from clpc.core.compact import compact_repr
 from clpc.core.jsonable import jsonable
 from clpc.data import DataError
 from clpc.io import load_model, read_table, write_table
@@ -19,6 +20,7 @@ __all__ = ["CompareResult", "CompareSettings", "SimulateResult", "compare_file",
 
 
 # =============================================================================== simulate
+@compact_repr
 @dataclass(frozen=True)
 class SimulateResult:
     """The outcome of :func:`simulate_file`.
@@ -131,6 +133,7 @@ class CompareSettings:
             check_int(self.k, "k", 1)
 
 
+@compact_repr
 @dataclass(frozen=True)
 class CompareResult:
     """The outcome of :func:`compare_file`.

@@ -14,6 +14,7 @@ import numpy as np
 
 from clpc.appraiser import CLPC
 from clpc.core.checks import check_choice, check_int, check_positive
+from clpc.core.compact import compact_repr
 from clpc.data import DataError
 from clpc.report import update_records
 from clpc.workflows.common import AppraiserSettings, SamplingConflictError, SettingsError
@@ -106,6 +107,7 @@ class StreamSettings:
         return self.n_in, self.n_out
 
 
+@compact_repr
 @dataclass(frozen=True)
 class StreamBatch:
     """What one batch of lines gave.

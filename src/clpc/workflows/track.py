@@ -15,6 +15,7 @@ from clpc.appraiser.decimation import Decimator, decimation_factor
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
+from clpc.core.compact import compact_repr
 from clpc.core.figure import MAX_POINTS
 from clpc.data import DataError, IOData
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
@@ -78,6 +79,7 @@ class TrackSettings:
             )
 
 
+@compact_repr
 @dataclass(frozen=True)
 class TrackResult:
     """The outcome of :func:`track_file`.

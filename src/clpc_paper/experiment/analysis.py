@@ -52,14 +52,14 @@ def stable_inverse(model: LinearModel, y: Any) -> np.ndarray:
 
 
 def _a_of(model: LinearModel, y: Any) -> np.ndarray:
-    """``A(z) y`` with the outputs before ``y[0]`` equal to ``y[0]``."""
+    """``den(z) y`` with the outputs before ``y[0]`` equal to ``y[0]``."""
     yv = np.asarray(y, dtype=np.float64)
     na = model.structure.na
     return np.asarray(signal.lfilter(model.den, [1.0], np.r_[np.full(na, yv[0]), yv])[na:])
 
 
 def _inverse_b(model: LinearModel, w: np.ndarray) -> np.ndarray:
-    """``u`` with ``B(z) u = w``: zeros of B inside the circle forwards, outside backwards.
+    """``u`` with ``num(z) u = w``: zeros of num inside the circle forwards, outside backwards.
 
     The forward part starts at rest (the inputs before ``w[0]`` are 0, as in
     :meth:`LinearModel.infer_input`); the backward part starts in the steady state of the

@@ -29,7 +29,8 @@ __all__ = [
 ]
 
 _INVERSE = (
-    "estimate: steady-state actuator model run backwards, u = (A(z) y - k)/B(z) (stable inverse)"
+    "estimate: steady-state actuator model run backwards, u = (den(z) y - k)/num(z) "
+    "(stable inverse)"
 )
 
 

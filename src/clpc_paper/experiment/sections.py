@@ -167,8 +167,8 @@ def section_torque(summary: dict[str, Any]) -> list[str]:
     smooth = summary.get("torque_without_friction")
     best = act_r["torque_best_window"]
     text = (
-        "The estimated torque is the actuator model run backwards, u = (A(z) y - k)/B(z). "
-        "Sampling a double integrator puts a zero of B(z) outside the unit circle, so the "
+        "The estimated torque is the actuator model run backwards, u = (den(z) y - k)/num(z). "
+        "Sampling a double integrator puts a zero of num(z) outside the unit circle, so the "
         "causal inverse (`LinearModel.infer_input`) is unstable; for the ramp model it "
         f'answers: "{act_r["causal_inverse"]}" The figures use the stable non-causal '
         "inverse (`clpc_paper.experiment.stable_inverse`: zeros inside the circle inverted "

@@ -147,8 +147,8 @@ def _pick_loop(engine: str) -> Loop:
     if loop is None:
         if engine == "numba":
             raise ValueError(
-                "engine='numba' needs numba, which is not installed. Install the 'sim' extra "
-                "(pip install 'clpc[sim]') or pass engine='auto'."
+                "engine='numba' needs numba (a dependency of clpc), which is not installed: "
+                "pip install numba, or pass engine='auto'."
             )
         return _servo_loop_py
     return loop
