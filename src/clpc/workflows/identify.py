@@ -10,6 +10,7 @@ from typing import Any, Literal
 import numpy as np
 
 from clpc.core.checks import check_choice, check_int
+from clpc.core.compact import compact_repr
 from clpc.core.jsonable import jsonable
 from clpc.io import save_model
 from clpc.lpc import LPC, Identification, OrderSelection, identify, select_delay, select_order
@@ -108,6 +109,7 @@ class IdentifySettings:
         return self.estimator != "lpc"
 
 
+@compact_repr
 @dataclass(frozen=True)
 class IdentifyResult:
     """The outcome of :func:`identify_file`.
