@@ -89,6 +89,8 @@ class Screen:
         nk = np.array([s.nk for s in self.structures])
         na = np.array([s.na for s in self.structures])
         for among in (na < first.na, nk != first.nk):
+            among = among.copy()
+            among[picks] = False  # each structure once
             if len(picks) < size and among.any():
                 picks.append(self.best(among))
         return picks

@@ -48,6 +48,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
@@ -139,6 +140,7 @@ class Identification:
         return pd.DataFrame(self.table)
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # small solves: threads only thrash
 def identify(
     u: Any,
     y: Any | None = None,
