@@ -68,6 +68,15 @@ def test_auto_order_picks_four_on_noise_free_data():
     assert set(model.info["order_scores"]) >= {"3", "4", "5"}
 
 
+def test_auto_model_is_the_fixed_order_model():
+    u, y = _siso(13, 2500, snr_db=25.0)
+    auto = Subspace(**FAST).fit(u, y)
+    fixed = Subspace(order=auto.info["order"], **FAST).fit(u, y)
+    np.testing.assert_array_equal(auto.theta, fixed.theta)
+    assert auto.info["horizon"] == fixed.info["horizon"] == 10
+    assert fixed.info["order_reason"] == "order 4 given"
+
+
 def test_simulate_reproduces_dlsim_of_the_state_space_model():
     # a record from rest with no offset: the model's free run (offset included) is dlsim's
     u, y = _siso(2, 2000)
@@ -223,8 +232,13 @@ def test_model_interface_like_other_estimators(tmp_path):
     assert model.dc_gain()[0, 0] == pytest.approx(gain, rel=0.02)
     assert model.is_stable
     assert model.to_scipy().dt == 0.01
-    # no covariance, and it says why
+    # no covariance, and it says why; the verdict and the summary name the estimator
     assert "closed-form" in model.info["covariance_note"]
+    assert model.info["method"] == "subspace"
+    assert "subspace identification has no eigenvalue" in str(model.verdict())
+    from clpc.report.text import estimator_name
+
+    assert estimator_name(model.info) == "subspace (PO-MOESP)"
     # the evidence on demand: a refit at the fitted order on the first two thirds
     model.assess()
     assert model.info["heldout"]["free_run"] > 90

@@ -251,13 +251,13 @@ class Subspace:
             thetas.append(theta)
             cs.append(c)
         info: dict[str, Any] = {
-            "method": "subspace (PO-MOESP)",
+            "method": "subspace",
             "noise_model": "output-error",
             "order": order,
-            "horizon": fits[0].horizon,
             "feedthrough": bool(self.feedthrough),
         }
-        keys = ("singular_values", "order_reason", "order_scores", "state_space", "bd_form")
+        keys = ("horizon", "singular_values", "order_reason", "order_scores", "state_space",
+                "bd_form")  # fmt: skip
         for key in keys:
             values = [getattr(f, key) for f in fits]
             info[key] = values[0] if mode != "paired" else values
