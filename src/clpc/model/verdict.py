@@ -147,6 +147,7 @@ def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, An
 _NO_EIGENVALUES = {
     "least-squares": "least squares has no eigenvalue structure to judge",
     "output-error": "output error has no eigenvalue structure to judge",
+    "subspace": "subspace identification has no eigenvalue structure to judge",
     "clpc-steady-state": "an average of CLPC windows: each window's statistics are in the trace",
 }
 

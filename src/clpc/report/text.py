@@ -17,6 +17,7 @@ _ESTIMATORS = {
     "paper": "LPC",
     "least-squares": "ARX (least squares)",
     "output-error": "OE (output error)",
+    "subspace": "subspace (PO-MOESP)",
     "clpc-steady-state": "CLPC",
     "multimodel-linearization": "multi-model linearization",
 }
@@ -46,8 +47,8 @@ def format_fit(v: float | None) -> str:
 def estimator_name(summary: Mapping[str, Any]) -> str:
     """The estimator that produced the model, from ``summary["method"]`` (and ``estimators``).
 
-    ``"LPC"``, ``"ARX (least squares)"``, ``"OE (output error)"``, ``"CLPC"``,
-    ``"identify: OE, ARX"`` (one estimator per output), else ``"linear"``.
+    ``"LPC"``, ``"ARX (least squares)"``, ``"OE (output error)"``, ``"subspace (PO-MOESP)"``,
+    ``"CLPC"``, ``"identify: OE, ARX"`` (one estimator per output), else ``"linear"``.
     """
     method = summary.get("method")
     if method == "identify":
