@@ -1,4 +1,4 @@
-"""How long ``identify`` takes with everything automatic (issue 25: < 3 s at 3,000 samples, < 20 s at 25,000).
+"""How long ``identify`` takes with everything automatic (issue 25 targets: 3 s and 20 s).
 
 A 4th-order plant with a 2-sample delay (two real poles, one complex pair), coloured input,
 5 % output noise, ``dt = 10 ms``. For each record length, in one run:

@@ -6,6 +6,7 @@ See :mod:`clpc.lpc.selection` for the rules and :mod:`clpc.lpc.choice` for the c
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -16,6 +17,7 @@ from clpc.lpc.arx import ARX
 from clpc.lpc.choice import ranked
 from clpc.lpc.estimator import LPC
 from clpc.lpc.oe import OE
+from clpc.lpc.subspace import Subspace
 from clpc.lpc.uncertainty import with_covariance, without_covariance
 from clpc.model import LinearModel, ModelError
 from clpc.model.structure import Structure
@@ -30,18 +32,14 @@ __all__ = [
     "make",
     "rolling_origin",
     "stable_refits",
+    "subspace_structure",
 ]
 
 #: The first two rolling origins, as shares of the record (the last: ``1 - f``).
 ORIGINS = (1.0 / 2.0, 2.0 / 3.0)
-MAKERS = {"lpc": LPC, "arx": ARX, "oe": OE}
+MAKERS: dict[str, Any] = {"lpc": LPC, "arx": ARX, "oe": OE, "subspace": Subspace}
 #: The estimator families :func:`clpc.identify` compares, in the order it fits them.
-FAMILIES = ("arx", "lpc", "oe")
-
-
-def _cheap(**kw: Any) -> dict[str, Any]:
-    """Settings of a candidate fit: no covariance, no held-out assessment (scored here)."""
-    return kw | {"uncertainty": False, "assess": False}
+FAMILIES = ("arx", "lpc", "oe", "subspace")
 
 
 def rolling_origin(data: IOData, fraction: float) -> list[tuple[IOData, IOData]]:
@@ -124,16 +122,38 @@ def candidate(
 
 
 def make(
-    name: str, structure: Structure, mimo: str | None, initial: LinearModel | None = None
+    name: str,
+    structure: Structure,
+    mimo: str | None,
+    initial: LinearModel | None = None,
+    evidence: bool = False,
 ) -> Any:
-    """The estimator ``name`` at ``structure``, without covariance or assessment.
+    """The estimator ``name`` whose models have ``structure``.
 
-    ``initial`` (OE only): start the search there alone.
+    ``evidence``: with covariance and assessment (default without). ``initial`` (OE only):
+    start the search there alone. A subspace model of order ``n`` has ``na = n`` and
+    ``nb = n, nk = d`` with feedthrough, ``nb = n - 1, nk = d + 1`` without
+    (:class:`clpc.lpc.subspace.Subspace`): ``structure`` gives its order, delay and
+    feedthrough back.
     """
-    kw = _cheap(na=structure.na, nb=structure.nb, nk=structure.nk, mimo=mimo)
+    kw: dict[str, Any] = {"uncertainty": evidence, "assess": evidence, "mimo": mimo}
+    if name == "subspace":
+        through = structure.nb == structure.na
+        nk = structure.nk - (0 if through else 1)
+        return Subspace(order=structure.na, nk=nk, feedthrough=through, **kw)
+    kw |= {"na": structure.na, "nb": structure.nb, "nk": structure.nk}
     if name == "oe" and initial is not None:
-        return OE(**kw, starts=(), initial=initial)
+        kw |= {"starts": (), "initial": initial}
     return MAKERS[name](**kw)
+
+
+def subspace_structure(order: int, nk: int) -> Structure:
+    """The structure of a subspace model of ``order`` for a screened delay ``nk``.
+
+    ``nk >= 1``: no feedthrough, ``u(t - nk)`` first (``Subspace(nk=nk - 1)``); ``nk = 0``:
+    with feedthrough.
+    """
+    return Structure(order, order, 0) if nk == 0 else Structure(order, order - 1, nk)
 
 
 def _stability(radius: float) -> str:
@@ -201,20 +221,12 @@ def final_model(
     mix). ``evidence=False``: neither covariance nor assessment (the refit). ``initial``: an
     OE fit of the same structure that starts OE's search (the last origin's optimum).
     """
-    flags = {"uncertainty": evidence, "assess": evidence}
-    shape = {"na": structure.na, "nb": structure.nb, "nk": structure.nk, "mimo": mimo}
-    start: dict[str, Any] = {} if initial is None else {"starts": (), "initial": initial}
     if len(set(chosen)) == 1:
-        more = start if chosen[0] == "oe" else {}
-        return MAKERS[chosen[0]](**shape, **flags, **more).fit(data)
+        return make(chosen[0], structure, mimo, initial, evidence).fit(data)
     fits = {}
     for name in set(chosen):
-        kw: dict[str, Any] = {**shape, **flags, "assess": False}
-        if name == "lpc":
-            kw["cancel"] = False
-        elif name == "oe":
-            kw |= start
-        fits[name] = MAKERS[name](**kw).fit(data)
+        est = replace(make(name, structure, mimo, initial, evidence), assess=False)
+        fits[name] = (replace(est, cancel=False) if name == "lpc" else est).fit(data)
     first = fits[chosen[0]]
     model = LinearModel(
         theta=np.array([fits[name].theta_matrix[j] for j, name in enumerate(chosen)]),

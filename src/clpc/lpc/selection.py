@@ -63,6 +63,7 @@ from clpc.lpc.comparison import (
     make,
     rolling_origin,
     stable_refits,
+    subspace_structure,
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
 from clpc.lpc.gain_choice import prefer_determined_gain
@@ -290,8 +291,14 @@ def _candidates(
     last_oe: dict[Structure, LinearModel] = {}
     shapes = ", ".join(f"na={s.na} nb={s.nb} nk={s.nk}" for s in short)
     for name in FAMILIES:
+        where = short
+        if name == "subspace":  # the state dimension that holds each structure's lags
+            where = list(
+                dict.fromkeys(subspace_structure(max(s.na, s.nb + 1), s.nk) for s in short)
+            )
+            shapes = ", ".join(f"order {s.na} nk={s.nk}" for s in where)
         say(f"{name.upper()}: {shapes} at {len(folds)} origins")
-        for s in short:
+        for s in where:
             got, model = candidate(name, s, mode, (folds, k))
             rows += [r | {"n_params": s.na + blocks * (s.nb + 1)} for r in got]
             if name == "oe" and model is not None:
