@@ -23,6 +23,7 @@ from clpc.cli.options import (
 from clpc.cli.output import echo_json
 from clpc.lpc.selection import ESTIMATORS, pct
 from clpc.report import format_model_summary, write_identify_report
+from clpc.report.identifiability import lead_lines
 from clpc.report.text import estimator_name
 from clpc.workflows import IdentifyResult, IdentifySettings, identify_file
 
@@ -168,10 +169,13 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
 def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> None:
     """Identify a linear model -B(z)/A(z) from a record with batch LPC.
 
-    Prints the monic transfer function (powers of z^-1), poles and stability, the degree of
-    linearity D, the fit % of the free-run simulation and of 1- and 10-step predictions on
-    the same data, and whether the data determine the model. With --estimator (or --nk
-    auto) LPC, least squares and output error are first compared on held-out data.
+    Opens with what the record cannot decide (an input not persistently exciting of the
+    order, an undetermined DC gain), then prints the monic transfer function (powers of
+    z^-1), the DC gains +- one sigma, the poles (the dominant ones in rad/s, Hz, damping,
+    time constants) and stability, the degree of linearity D, the fit % of the free-run
+    simulation and of 1- and 10-step predictions on the same data, and the verdict. With
+    --estimator (or --nk auto) LPC, least squares and output error are first compared on
+    held-out data.
 
     \b
     Examples:
@@ -184,11 +188,13 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
     if as_json:
         echo_json(result.summary)
         return
+    for line in lead_lines(result.summary):  # what the data cannot decide, first
+        click.echo(line)
     if result.comparison is not None:
         click.echo("\n".join(_comparison_lines(result)))
     if result.selection is not None:
         click.echo(_selection_line(result))
-    click.echo(format_model_summary(result.summary))
+    click.echo(format_model_summary(result.summary, lead=False))
     if settings.save:
         click.echo(f"model saved to {settings.save}")
     if report:
@@ -213,5 +219,6 @@ def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: st
         title=f"identify report ({estimator_name(result.summary)} model): {Path(record.file).name}",
         settings=shown,
         selection=result.summary.get("order_selection"),
+        comparison=result.comparison,
     )
     return files[-1]
