@@ -26,6 +26,7 @@ from clpc.cli.options import (
 from clpc.cli.output import echo_json
 from clpc.lpc.selection import ESTIMATORS, pct
 from clpc.report import format_model_summary, write_identify_report
+from clpc.report.identifiability import lead_lines
 from clpc.report.text import estimator_name
 from clpc.workflows import IdentifyResult, IdentifySettings, identify_file
 
@@ -180,12 +181,15 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
 def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> None:
     """Identify a linear model -B(z)/A(z) from a record: structure and estimator chosen.
 
-    By default the orders na, nb and the delay nk are screened by least squares, least
-    squares, LPC and output error are compared on held-out data at the best structures, and
-    the best is kept (the table and the reason are printed; a progress line per stage on a
-    terminal). Then the monic transfer function (powers of z^-1), poles and stability, the
+    By default the orders na, nb and the delay nk are screened by least squares; least
+    squares, LPC, output error and subspace models are compared on held-out data at the best
+    structures, and the best is kept (the table and the reason are printed; a progress line
+    per stage on a terminal). --estimator lpc fits the paper's LPC alone. Then: what the
+    record cannot decide (an input not persistently exciting of the order, an undetermined
+    DC gain) first, the monic transfer function (powers of z^-1), the DC gains +- one sigma,
+    the poles (the dominant ones in rad/s, Hz, damping, time constants) and stability, the
     fit % of the free-run simulation and of 1- and 10-step predictions on the same data,
-    and whether the data determine the model. --estimator lpc fits the paper's LPC alone.
+    and the verdict.
 
     \b
     Examples:
@@ -198,11 +202,13 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
     if as_json:
         echo_json(result.summary)
         return
+    for line in lead_lines(result.summary):  # what the data cannot decide, first
+        click.echo(line)
     if result.comparison is not None:
         click.echo("\n".join(_comparison_lines(result)))
     if result.selection is not None:
         click.echo(_selection_line(result))
-    click.echo(format_model_summary(result.summary))
+    click.echo(format_model_summary(result.summary, lead=False))
     if settings.save:
         click.echo(f"model saved to {settings.save}")
     if report:
@@ -240,5 +246,6 @@ def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: st
         title=f"identify report ({estimator_name(result.summary)} model): {Path(record.file).name}",
         settings=shown,
         selection=result.summary.get("order_selection"),
+        comparison=result.comparison,
     )
     return files[-1]

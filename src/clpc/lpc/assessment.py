@@ -25,6 +25,7 @@ from clpc.data import DataError, IOData
 from clpc.lpc import heldout
 from clpc.model import LinearModel, ModelError
 from clpc.model.evidence import FitRecord
+from clpc.model.excitation import excitation_entries
 from clpc.model.residuals import residual_analysis
 
 __all__ = ["HELDOUT_FRACTION", "assess", "evidence", "fit_record"]
@@ -117,14 +118,18 @@ def fit_record(
         The estimator (a dataclass with ``assess`` and ``uncertainty`` flags): with
         ``assess``, :func:`evidence` is offered, refitting a copy of it without evidence.
     covariance : callable, optional
-        ``f(model) -> dict`` of covariance entries, offered when given.
+        ``f(model) -> dict`` of covariance entries, offered when given. The input's order
+        of persistent excitation (:func:`clpc.model.excitation.excitation_entries`) is
+        always offered.
 
     Returns
     -------
     FitRecord
         Nothing is computed yet (:mod:`clpc.model.evidence`).
     """
-    record = FitRecord(data)
+    record = FitRecord(data).with_producer(
+        "excitation", lambda fitted: excitation_entries(fitted, data)
+    )
     if covariance is not None:
         record = record.with_producer("covariance", covariance)
     if estimator.assess:
@@ -134,5 +139,6 @@ def fit_record(
 
 
 def assess(model: LinearModel, data: IOData, refit: Callable[[IOData], LinearModel]) -> LinearModel:
-    """``model`` with the entries of :func:`evidence` in its ``info`` (computed now)."""
-    return replace(model, info={**model.info, **evidence(model, data, refit)})
+    """``model`` with the entries of :func:`evidence` and the excitation in its ``info`` (now)."""
+    found = {**evidence(model, data, refit), **excitation_entries(model, data)}
+    return replace(model, info={**model.info, **found})

@@ -2,9 +2,10 @@
 
 A fit returns its estimate and what comes free with the solve (eigenvalues, ``D``, ``J``,
 ``c``, a least-squares covariance). The costlier evidence - the held-out fit of a refit on
-part of the record, the residual tests, a block-jackknife covariance - is computed only
-when a caller reads it: ``model.info["heldout"]``, ``model.info["residual_test"]``,
-``model.info["covariance"]`` (or :meth:`clpc.LinearModel.assess` for all of it). The
+part of the record, the residual tests, a block-jackknife covariance, the input's order of
+persistent excitation - is computed only when a caller reads it: ``model.info["heldout"]``,
+``model.info["residual_test"]``, ``model.info["covariance"]``,
+``model.info["excitation_order"]`` (or :meth:`clpc.LinearModel.assess` for all of it). The
 result is stored in the model's ``info``, so the second read costs nothing.
 
 The model keeps a :class:`FitRecord`, the record it was fitted on and one function per kind
@@ -35,6 +36,14 @@ Producer = Callable[[Any], dict[str, Any]]
 EVIDENCE_KEYS: dict[str, tuple[str, ...]] = {
     "assessment": ("heldout", "residual_test"),
     "covariance": ("covariance", "covariance_dof", "covariance_method", "covariance_note"),
+    "excitation": (
+        "excitation_order",
+        "excitation_needed",
+        "excitation_ratio",
+        "excitation_threshold",
+        "output_std",
+        "input_std",
+    ),
 }
 
 

@@ -1,4 +1,4 @@
-"""Identifiability verdicts in plain words, for a fit and for every cluster of a trace.
+"""Identifiability verdicts in plain words, for a fit (and, re-exported, for a trace).
 
 The numbers behind them come from the solve (:mod:`clpc.lpc.solve`): the dimension of the
 near-null subspace the solution was taken from (``n_null``), the near-null relations that
@@ -12,6 +12,12 @@ and the residual tests. The model is *adequate* when the held-out free-run fit i
 :data:`clpc.core.rules.MIN_HELDOUT_FIT` % and the residuals are independent of the input;
 "the data determine the parameters" speaks of identifiability only and never stands alone
 beside a model that is not adequate.
+
+What the record cannot decide comes first (:mod:`clpc.model.identifiability`): an input not
+persistently exciting of the order the structure needs, or a DC gain whose sign is
+undetermined, opens the verdict with its numbers and thresholds, and the verdict then
+states the held-out fit without calling the model good. One finding per message;
+``str(verdict)`` puts each on its own line.
 """
 
 from __future__ import annotations
@@ -24,6 +30,8 @@ import numpy as np
 from clpc.core.compact import compact_repr
 from clpc.core.polynomials import pole_class, pole_words
 from clpc.core.rules import MIN_HELDOUT_FIT
+from clpc.model.identifiability import identifiability
+from clpc.model.trace_findings import describe_trace
 
 __all__ = ["Verdict", "describe_trace", "fit_verdict"]
 
@@ -57,6 +65,14 @@ class Verdict:
     adequate : bool or None
         Held-out free-run fit at least :data:`~clpc.core.rules.MIN_HELDOUT_FIT` % and
         residuals independent of the input (``None``: not assessed).
+    identifiable : bool or None
+        The input excites the order the structure needs and every DC gain's sign is
+        determined (:class:`clpc.model.identifiability.Identifiability`); ``None``: not
+        judged.
+    excitation_order, needed_order : int or None
+        The record's input's order of persistent excitation (up to the needed order;
+        ``None``: the model keeps no record) and the order the structure needs
+        (``na + nb + 1``).
     """
 
     n_null: int
@@ -71,9 +87,12 @@ class Verdict:
     residuals_independent: bool | None = None
     residuals_white: bool | None = None
     adequate: bool | None = None
+    identifiable: bool | None = None
+    excitation_order: int | None = None
+    needed_order: int | None = None
 
     def __str__(self) -> str:
-        return "; ".join(self.messages)
+        return "\n".join(self.messages)
 
 
 def _fmt(fit: float) -> str:
@@ -82,8 +101,14 @@ def _fmt(fit: float) -> str:
     return f"{fit:.1f} %" if abs(fit) < 1e4 else f"{fit:.2g} %"
 
 
-def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, Any]]:
-    """Words and numbers of the stored held-out fit and residual tests of one output."""
+def evidence(
+    info: dict[str, Any], output: int, neutral: bool = False
+) -> tuple[list[str], dict[str, Any]]:
+    """Words and numbers of the stored held-out fit and residual tests of one output.
+
+    ``neutral``: the record does not identify the model, so no head calls it good (the
+    held-out fit is stated, not judged a fit).
+    """
     msgs: list[str] = []
     found: dict[str, Any] = {}
     held = info.get("heldout")
@@ -133,13 +158,15 @@ def evidence(info: dict[str, Any], output: int) -> tuple[list[str], dict[str, An
     if "heldout_fit" in found and "residuals_independent" in found:
         ok = found["heldout_fit"] >= MIN_HELDOUT_FIT and found["residuals_independent"]
         found["adequate"] = bool(ok)
-        if ok:
-            head = "the model describes the record"
-        elif found["heldout_fit"] >= MIN_HELDOUT_FIT:
-            head = "the model fits held-out data, but its residuals still carry the input"
-        else:
-            head = "the model does NOT describe the record well"
-        msgs.insert(0, head)
+        if not found["heldout_fit"] >= MIN_HELDOUT_FIT:
+            msgs.insert(0, "the model does NOT describe the record well")
+        elif not neutral:
+            msgs.insert(
+                0,
+                "the model describes the record"
+                if ok
+                else "the model fits held-out data, but its residuals still carry the input",
+            )
     return msgs, found
 
 
@@ -168,12 +195,19 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
     Verdict
     """
     info = model.info
-    words, found = evidence(info, output)
+    ident = identifiability(model, output)
+    lead = ident.messages(model.structure)
+    words, found = evidence(info, output, neutral=bool(lead))
+    found |= {
+        "identifiable": ident.identifiable,
+        "excitation_order": ident.excitation_order,
+        "needed_order": ident.needed_order,
+    }
     stable, kind, said = _stability(model, output)
     if "n_null" not in info:  # e.g. least squares, or a CLPC steady-state model
         what = "no eigenvalue statistics" if words else "no fit statistics"
         why = _NO_EIGENVALUES.get(str(info.get("method")), "a loaded or hand-built model")
-        notes = (*words, f"{what} ({why})", f"the model is {said}")
+        notes = (*lead, *words, f"{what} ({why})", f"the model is {said}")
         return Verdict(
             0, True, False, stable, model.structure.nb + 1, notes, stability=kind, **found
         )
@@ -203,7 +237,12 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
             f"{n_null - n_input} output relations are equally small: the order may be larger "
             "than the system's (common pole-zero factors); consider a lower order"
         )
-    if determined:
+    if determined and lead:
+        msgs.append(
+            f"one eigenvector stands out (eigenvalue separation {sep:.2g}), yet the record "
+            "leaves the model undetermined (above)"
+        )
+    elif determined:
         but = " - identifiability only, not a good fit" if found.get("adequate") is False else ""
         msgs.append(f"the data determine the parameters (eigenvalue separation {sep:.2g}){but}")
     elif not n_input and n_null == 1:
@@ -213,7 +252,14 @@ def fit_verdict(model: Any, output: int = 0) -> Verdict:
         )
     msgs.append(f"the model is {said}")
     return Verdict(
-        n_null, n_input == 0, determined, stable, order, (*words, *msgs), stability=kind, **found
+        n_null,
+        n_input == 0,
+        determined,
+        stable,
+        order,
+        (*lead, *words, *msgs),
+        stability=kind,
+        **found,
     )
 
 
@@ -225,68 +271,3 @@ def _stability(model: Any, output: int) -> tuple[bool, str, str]:
         return False, "unstable", "NOT stable (no poles)"
     kind = pole_class(poles)
     return bool(np.all(np.abs(poles) < 1.0)), kind, pole_words(kind)
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Inclusive index ranges where ``mask`` is true."""
-    if not mask.any():
-        return []
-    edges = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
-    starts = np.flatnonzero(edges == 1)
-    ends = np.flatnonzero(edges == -1) - 1
-    return list(zip(starts.tolist(), ends.tolist(), strict=True))
-
-
-def _ranges(runs: list[tuple[int, int]], limit: int = 6) -> str:
-    parts = [f"{a}" if a == b else f"{a}-{b}" for a, b in runs[:limit]]
-    more = f" and {len(runs) - limit} more" if len(runs) > limit else ""
-    return ", ".join(parts) + more
-
-
-def describe_trace(trace: Any) -> list[str]:
-    """Plain-language findings over the clusters of a CLPC trace (clusters numbered from 1).
-
-    Parameters
-    ----------
-    trace : Trace
-        The per-cluster record of a CLPC run (:class:`clpc.Trace`).
-
-    Returns
-    -------
-    list of str
-        E.g. ``"input is not persistently exciting of order 3 in clusters 14-37: the
-        parameters there are held"``.
-    """
-    arr = trace.arrays
-    held_note = " (the parameters there are held)" if trace.meta.get("guard") else ""
-    order = trace.structure.nb + 1
-    out = []
-    n = len(trace)
-
-    def add(mask: np.ndarray, text: str) -> None:
-        runs = [(a + 1, b + 1) for a, b in _runs(mask)]
-        if runs:
-            out.append(f"{text} in clusters {_ranges(runs)}{held_note}")
-
-    add(trace.not_enough_data, "fewer lag vectors than min_rows")
-    add(arr["degenerate"].any(axis=1), "nothing varies (degenerate window)")
-    add(
-        (arr["n_input_relations"] > 0).any(axis=1),
-        f"input is not persistently exciting of order {order}",
-    )
-    poorly = ~arr["determined"].any(axis=1) & ~arr["degenerate"].any(axis=1)
-    poorly &= ~trace.not_enough_data & ~(arr["n_input_relations"] > 0).any(axis=1)
-    add(poorly, "the window does not determine the parameters")
-    add(arr["has_model"].all(axis=1) & ~arr["stable"].all(axis=1), "the model is unstable")
-    if "excited" in arr:
-        add(
-            ~arr["excited"].all(axis=1) & ~arr["degenerate"].any(axis=1),
-            "a channel varies by fewer than 3 quantization steps",
-        )
-    good = int((arr["determined"].all(axis=1)).sum())
-    out.append(f"{good} of {n} clusters determine the parameters")
-    if "trusted" in arr:
-        trusted = int(arr["trusted"].all(axis=1).sum())
-        guard = "only these are accepted" if trace.meta.get("guard") else "the guard is off"
-        out.append(f"{trusted} of {n} clusters are trusted ({guard})")
-    return out

@@ -8,7 +8,7 @@ them from here.
 from clpc.appraiser.tracefile import trace_columns
 from clpc.core.jsonable import jsonable
 from clpc.report.comparison import Comparison, compare
-from clpc.report.html import Section, warnings_html, write_html_report
+from clpc.report.html import Section, table_html, warnings_html, write_html_report
 from clpc.report.identify import write_identify_report
 from clpc.report.summaries import (
     model_response,
@@ -31,6 +31,7 @@ __all__ = [
     "model_response",
     "model_summary",
     "steady_state",
+    "table_html",
     "trace_columns",
     "trace_summary",
     "update_records",

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Section", "warnings_html", "write_html_report"]
+__all__ = ["Section", "table_html", "warnings_html", "write_html_report"]
 
 #: an image: its file, or its file and a caption
 Image = str | PathLike[str] | tuple[str | PathLike[str], str]
@@ -95,16 +95,34 @@ def _cell(v: Any, tag: str = "td") -> str:
     return f"<{tag}>{html.escape(str(v))}</{tag}>"
 
 
-def _table_html(table: Mapping[str, Any] | Sequence[Sequence[Any]]) -> str:
+def table_html(
+    table: Mapping[str, Any] | Sequence[Sequence[Any]], caption: str | None = None
+) -> str:
+    """A table as HTML, as a :class:`Section` shows its ``table`` (cells escaped).
+
+    Parameters
+    ----------
+    table : mapping or sequence of rows
+        A mapping ``{name: value}`` (two columns) or rows whose first row is the header.
+    caption : str, optional
+        Shown above the table (plain text).
+
+    Returns
+    -------
+    str
+        A ``<table>`` element (``""`` for no rows); numbers right-aligned, 6 significant
+        digits, ``None`` as a dash.
+    """
+    cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
     if isinstance(table, Mapping):
         rows = [f"<tr>{_cell(k, 'th')}{_cell(v)}</tr>" for k, v in table.items()]
-        return "<table>" + "".join(rows) + "</table>"
+        return f"<table>{cap}" + "".join(rows) + "</table>"
     rows_in = [list(r) for r in table]
     if not rows_in:
         return ""
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in rows_in[0])
     body = "".join("<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in rows_in[1:])
-    return f"<table><tr>{head}</tr>{body}</table>"
+    return f"<table>{cap}<tr>{head}</tr>{body}</table>"
 
 
 def _image_html(image: Image, report_dir: Path, embed: bool) -> str:
@@ -155,7 +173,7 @@ def _section_html(sec: Section, report_dir: Path, embed: bool) -> str:
     if sec.preformatted:
         parts.append(f"<pre>{html.escape(sec.preformatted)}</pre>")
     if sec.table is not None:
-        parts.append(_table_html(sec.table))
+        parts.append(table_html(sec.table))
     parts += [_image_html(img, report_dir, embed) for img in sec.images]
     heading = html.escape(sec.heading)
     if not heading:  # an untitled section (e.g. an introduction under the title)

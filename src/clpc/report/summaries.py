@@ -1,7 +1,9 @@
 """Summaries of identified models and traces, as JSON-safe dicts.
 
 * :func:`model_summary` - transfer functions, poles, stability, ``D``, fit % of the free-run
-  simulation and of k-step predictions, and the identifiability verdict in plain words.
+  simulation and of k-step predictions, and the identifiability verdict in plain words;
+  per output the DC gains +- sigma and the dominant poles
+  (:func:`clpc.report.identifiability.identifiability_summary`).
 * :func:`model_response` - simulated or k-step-predicted output and its fit %.
 * :func:`update_records` - a CLPC trace as JSON-safe records (one per cluster update).
 * :func:`steady_state` / :func:`trace_summary` - the model a trace settles on, and the
@@ -24,6 +26,7 @@ from clpc.model import LinearModel, ModelError
 from clpc.model.residuals import residual_analysis
 from clpc.model.uncertainty import parameter_labels, parameter_std, parameter_vector
 from clpc.model.verdict import describe_trace, fit_verdict
+from clpc.report.identifiability import identifiability_summary
 
 __all__ = [
     "model_response",
@@ -55,7 +58,7 @@ def verdict_text(model: LinearModel, output: int = 0) -> str | None:
     str or None
     """
     has_eig = all(k in model.info for k in ("n_null", "n_input_relations", "determined"))
-    if not has_eig and "heldout" not in model.info:
+    if not has_eig and "heldout" not in model.info and "excitation_order" not in model.info:
         return None
     return str(fit_verdict(model, output))
 
@@ -108,6 +111,11 @@ def model_response(
     return y_hat, start, fit
 
 
+def _all_of(flags: list[bool | None]) -> bool | None:
+    """``False`` if any is, ``True`` if all are, else ``None`` (not judged)."""
+    return False if False in flags else (True if all(flags) else None)
+
+
 def model_summary(
     model: LinearModel, data: IOData | None = None, horizons: Sequence[int] = (1, 10)
 ) -> dict[str, Any]:
@@ -132,8 +140,12 @@ def model_summary(
         ``stable``, ``equations`` (one dict per output: ``den``, ``num`` per input,
         ``intercept``, ``poles`` as ``[re, im]`` pairs, ``stable``, ``D``, ``lambda_min``,
         ``eig_ratio``, ``noise_variance``, ``determined``, ``n_input_relations``,
-        ``verdict``) and, with data, ``n_samples`` and ``fit`` (``{"simulation": [...],
-        "prediction_1": [...], ...}``, one fit % per output, ``None`` if it diverges).
+        ``verdict`` (one finding per line), and ``dc_gain``, ``dominant_poles``,
+        ``identifiability`` of
+        :func:`clpc.report.identifiability.identifiability_summary`), ``identifiable``
+        (``False`` when an output is not, ``None`` when not judged) and, with data,
+        ``n_samples`` and ``fit`` (``{"simulation": [...], "prediction_1": [...], ...}``,
+        one fit % per output, ``None`` if it diverges).
     """
     s = model.structure
     info = model.info
@@ -166,6 +178,7 @@ def model_summary(
                 "determined": stat("determined", j),
                 "n_input_relations": stat("n_input_relations", j),
                 "verdict": verdict_text(model, j),
+                **identifiability_summary(model, j),
                 "parameters": [
                     {
                         "name": n,
@@ -190,9 +203,10 @@ def model_summary(
         "method": info.get("method"),
         **({"estimators": list(info["estimators"])} if "estimators" in info else {}),
         "scaling": info.get("scaling"),
-        "cancelled": info.get("cancelled", 0),
+        "cancelled": int(np.sum(info.get("cancelled", 0))),  # per output in a mixed model
         "stable": model.is_stable,
         "stability": model.stability,
+        "identifiable": _all_of([eq["identifiability"]["identifiable"] for eq in equations]),
         "equations": equations,
     }
     if data is not None:

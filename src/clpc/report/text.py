@@ -8,6 +8,7 @@ from typing import Any
 
 from clpc.core.polynomials import pole_words
 from clpc.model.display import poly_text
+from clpc.report.identifiability import lead_lines
 
 __all__ = ["estimator_name", "format_fit", "format_model_summary"]
 
@@ -57,13 +58,20 @@ def estimator_name(summary: Mapping[str, Any]) -> str:
     return _ESTIMATORS.get(str(method), "linear")
 
 
-def format_model_summary(summary: Mapping[str, Any]) -> str:
+def format_model_summary(summary: Mapping[str, Any], lead: bool = True) -> str:
     """Render :func:`model_summary` as readable text (one block per output).
+
+    What the record cannot decide comes first (the identifiability headline of each output
+    it does not identify); each output's block gives its DC gains +- one sigma and its
+    dominant poles, and its verdict one finding per line.
 
     Parameters
     ----------
     summary : mapping
         Output of :func:`clpc.report.model_summary` (with or without data).
+    lead : bool
+        Open with the identifiability headlines (default); ``False`` when the caller has
+        printed them already (``clpc identify`` prints them before its tables).
 
     Returns
     -------
@@ -71,7 +79,8 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
         Several lines, no trailing newline.
     """
     st = summary["structure"]
-    lines = [
+    lines = lead_lines(summary) if lead else []
+    lines += [
         f"{estimator_name(summary)} model  na={st['na']} nb={st['nb']} nk={st['nk']}  "
         f"method={summary['method']}  "
         f"scaling={summary.get('scaling')}  mode={summary['mode']}  dt={summary['dt']:g} s"
@@ -92,8 +101,13 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
             lines.append(f"  [{out}]  {inp} -> {out}:  num(z) = {poly_text(num)}")
         if eq["intercept"]:
             lines.append(f"  [{out}]  offset (intercept) {eq['intercept']:.6g}")
+        for gain in eq.get("dc_gain", ()):
+            lines.append(f"  [{out}]  DC gain {gain['input']} -> {out}: {gain['text']}")
         poles = ", ".join(_fmt_complex(re, im) for re, im in eq["poles"])
         lines.append(f"  [{out}]  poles: {poles}  -> {_stability(eq)}")
+        if eq.get("dominant_poles"):
+            slow = "; ".join(p["text"] for p in eq["dominant_poles"])
+            lines.append(f"  [{out}]  dominant poles: {slow}")
         if eq["D"] is not None:
             lines.append(
                 f"  [{out}]  D = lambda_max - lambda_min = {eq['D']:.6g}   lambda_min = "
@@ -107,7 +121,9 @@ def format_model_summary(summary: Mapping[str, Any]) -> str:
             )
             lines.append(f"  [{out}]  parameters (+- 1 sigma): {pars}")
         if eq["verdict"] is not None:
-            lines.append(f"  [{out}]  verdict: {eq['verdict']}")
+            first, *more = str(eq["verdict"]).split("\n")
+            lines.append(f"  [{out}]  verdict: {first}")
+            lines.extend(f"  [{out}]           {m}" for m in more)
         if "fit" in summary:
             fits = "   ".join(
                 f"{_fit_label(key)} {format_fit(vals[j])}" for key, vals in summary["fit"].items()
