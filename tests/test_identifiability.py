@@ -304,6 +304,10 @@ def records(tmp_path_factory):
     return out
 
 
+#: the paper's LPC at order 2 alone (the default chooses structure and estimator)
+LPC2 = ("--estimator", "lpc", "--order", "2")
+
+
 def identify(*args: str):
     result = CliRunner().invoke(cli, ["identify", *map(str, args)])
     assert result.exit_code == 0, result.output
@@ -311,13 +315,13 @@ def identify(*args: str):
 
 
 def test_the_command_line_prints_the_dc_gain_and_leads_with_what_is_undecided(records):
-    out = identify(records["white"], "-u", "u", "-y", "y", "--nk", "1", "--dt", "0.01")
+    out = identify(records["white"], "-u", "u", "-y", "y", *LPC2, "--nk", "1", "--dt", "0.01")
     model = clpc.LPC(order=2, nk=1).fit(*white_record(8), dt=0.01)
     (gain,) = clpc.assess_gain(model)
     assert f"[y]  DC gain u -> y: {gain.value}" in out and "±" in gain.value
     assert "[y]  dominant poles: " in out and "rad/s" in out and "damping" in out
     assert "NOT identifiable" not in out
-    out = identify(records["sine"], "-u", "u", "-y", "y", "--nk", "1", "--dt", "0.01")
+    out = identify(records["sine"], "-u", "u", "-y", "y", *LPC2, "--nk", "1", "--dt", "0.01")
     assert out.startswith("NOT identifiable from this record: input persistently exciting")
     assert "[y]  DC gain u -> y: undetermined: " in out
     verdict = next(line for line in out.splitlines() if "verdict:" in line)
@@ -326,7 +330,9 @@ def test_the_command_line_prints_the_dc_gain_and_leads_with_what_is_undecided(re
 
 def test_the_json_carries_the_same_numbers(records):
     summary = json.loads(
-        identify(records["sine"], "-u", "u", "-y", "y", "--nk", "1", "--dt", "0.01", "--json")
+        identify(
+            records["sine"], "-u", "u", "-y", "y", *LPC2, "--nk", "1", "--dt", "0.01", "--json"
+        )
     )
     eq = summary["equations"][0]
     model = clpc.LPC(order=2, nk=1).fit(*sine_record(8), dt=0.01)
@@ -379,8 +385,8 @@ class _Page(HTMLParser):
 
 def test_the_report_opens_with_what_the_record_decides(records, tmp_path):
     out = identify(
-        records["sine"], "-u", "u", "-y", "y", "--nk", "1", "--dt", "0.01",
-        "--estimator", "auto", "--report", tmp_path,
+        records["sine"], "-u", "u", "-y", "y", "--order", "2", "--nk", "1", "--dt", "0.01",
+        "--report", tmp_path,
     )  # fmt: skip
     assert out.startswith("NOT identifiable")
     page = _Page()
@@ -393,7 +399,7 @@ def test_the_report_opens_with_what_the_record_decides(records, tmp_path):
     assert page.warnings[0].startswith("NOT identifiable from this record")
     assert any("persistently exciting of order 2 only, needs 5" in w for w in page.warnings)
     assert page.captions[:2] == ["DC gains", "Dominant poles (slowest first)"]
-    found = clpc.identify(clpc.as_iodata(*sine_record(8), dt=0.01), estimator="auto", nk=1)
+    found = clpc.identify(clpc.as_iodata(*sine_record(8), dt=0.01), order=2, nk=1)
     for row in found.table:
         assert row["estimator"].upper() in page.cells
         assert f"{row['free_run']:.2f} %" in page.cells

@@ -9,7 +9,7 @@ import pytest
 from scipy import signal
 
 import clpc
-from clpc.lpc import choice, comparison, selection
+from clpc.lpc import choice, comparison, reasons
 from clpc.lpc.comparison import FAMILIES
 from clpc.lpc.eiv import RATIO, check_eiv, exact_input_tls
 from clpc.lpc.screen import screen
@@ -247,9 +247,9 @@ def test_settings_are_checked():
 
 
 def test_pct_formats():
-    assert selection.pct(84.21) == "84.2 %"
-    assert selection.pct(-8e51) == "-8.0e+51 %"
-    assert selection.pct(-math.inf) == "diverges"
+    assert reasons.pct(84.21) == "84.2 %"
+    assert reasons.pct(-8e51) == "-8.0e+51 %"
+    assert reasons.pct(-math.inf) == "diverges"
 
 
 def test_rolling_origins_fit_the_past_and_score_the_rest():

@@ -82,6 +82,9 @@ def results(record, tmp_path_factory) -> dict[str, Any]:
         "IOData": clpc.IOData.concat([record[:400], record[400:]]),
         "LinearModel": model,
         "Verdict": clpc.fit_verdict(model),
+        "GainAssessment": clpc.assess_gain(model)[0],
+        "Identifiability": clpc.model.identifiability(model),
+        "DominantPole": clpc.dominant_poles(model)[0],
         "ResidualAnalysis": clpc.residual_analysis(model, u, y),
         "Identification": clpc.identify(record, order=2, nk=0),  # three rows: all shown
         "OrderSelection": clpc.select_order(record, orders=range(1, 4)),

@@ -24,7 +24,8 @@ from clpc.cli.options import (
     save_option,
 )
 from clpc.cli.output import echo_json
-from clpc.lpc.selection import ESTIMATORS, pct
+from clpc.lpc.reasons import pct
+from clpc.lpc.selection import ESTIMATORS
 from clpc.report import format_model_summary, write_identify_report
 from clpc.report.identifiability import lead_lines
 from clpc.report.text import estimator_name

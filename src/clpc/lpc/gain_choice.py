@@ -4,16 +4,15 @@ A model can fit held-out data and still leave its steady-state gain undetermined
 input that does not excite low frequencies (a sine sweep that starts high, a narrow band),
 ``G(1)`` is an extrapolation, and its standard deviation (delta method on the parameter
 covariance, :meth:`clpc.LinearModel.dc_gain_std`) exceeds its magnitude, so not even its sign
-is known. An engineer would take a candidate that fits nearly as well and determines its
-gain over one that does not: the chosen model gives way to the next usable candidate
-(ranked as :mod:`clpc.lpc.choice` ranks them) within :data:`GAIN_POINTS` points of its
-mean held-out free run whose refit determines every gain (``sigma <= |gain|``). When none
-does, the choice stands and the reason says so.
+is known (:func:`clpc.model.gain.assess_gain`). An engineer would take a candidate that fits
+nearly as well and determines its gain over one that does not: the chosen model gives way
+to the best other usable candidate within :data:`GAIN_POINTS` points of its mean held-out
+free run whose refit determines every gain. When none does, the choice stands and the
+reason says so.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -22,9 +21,10 @@ from clpc.data import DataError, IOData
 from clpc.lpc.choice import tier
 from clpc.lpc.comparison import final_model, key
 from clpc.model import LinearModel, ModelError
+from clpc.model.gain import GainAssessment, assess_gain
 from clpc.model.structure import Structure
 
-__all__ = ["GAIN_POINTS", "MAX_TRIES", "gain_spread", "prefer_determined_gain"]
+__all__ = ["GAIN_POINTS", "MAX_TRIES", "prefer_determined_gain", "undetermined"]
 
 #: Points of mean held-out free run a candidate with a determined gain may give away.
 GAIN_POINTS = 5.0
@@ -32,19 +32,14 @@ GAIN_POINTS = 5.0
 MAX_TRIES = 3
 
 
-def gain_spread(model: LinearModel) -> float:
-    """The largest ``sigma / |gain|`` over the model's input-output pairs.
+def undetermined(model: LinearModel) -> list[GainAssessment]:
+    """The model's input-output pairs whose DC gain the data do not determine.
 
-    ``> 1``: some gain is undetermined (its sign is not known). ``nan`` when the model has
-    no covariance (its gain's spread is unknown, not undetermined).
+    (:func:`clpc.model.gain.assess_gain`: ``sigma > |gain|``, or an input not persistently
+    exciting of the order the structure needs); an integrator's or a gain without sigma is
+    not counted (unknown is not undetermined).
     """
-    try:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.asarray(model.dc_gain_std()) / np.abs(np.asarray(model.dc_gain()))
-    except (ModelError, ValueError, np.linalg.LinAlgError):
-        return math.nan
-    ratio = np.where(np.isnan(ratio), np.inf, ratio)
-    return float(np.max(ratio))
+    return [g for g in assess_gain(model) if g.determined is False]
 
 
 def prefer_determined_gain(
@@ -76,8 +71,8 @@ def prefer_determined_gain(
     note : str
         What happened, in words (empty when the gain is determined or unknown).
     """
-    spread = gain_spread(model)
-    if not spread > 1.0:
+    lost = undetermined(model)
+    if not lost:
         return model, picks, ""
     outputs = sorted({r["output"] for r in rows}, key=[rows[i]["output"] for i in picks].index)
     mean = float(np.mean([rows[i]["free_run"] for i in picks]))
@@ -96,7 +91,7 @@ def prefer_determined_gain(
             other = final_model(data, (name,) * len(outputs), Structure(*where), mimo)
         except (ModelError, DataError, np.linalg.LinAlgError):
             continue
-        if gain_spread(other) <= 1.0:
+        if not undetermined(other):
             for i in picks:
                 rows[i]["chosen"] = False
             for i in idx:
@@ -104,14 +99,14 @@ def prefer_determined_gain(
             return (
                 other,
                 idx,
-                f"the first choice's DC gain is undetermined (sigma {spread:.2g} times "
-                f"|gain|); {name.upper()} na={where[0]} nb={where[1]} nk={where[2]} fits "
+                f"the first choice's DC gain is undetermined ({lost[0].finding()}); "
+                f"{name.upper()} na={where[0]} nb={where[1]} nk={where[2]} fits "
                 f"{score:.1f} % held out (within {GAIN_POINTS:g} points of {mean:.1f} %) "
                 "and determines its gain",
             )
     return (
         model,
         picks,
-        f"the DC gain is undetermined (sigma {spread:.2g} times |gain|) and no candidate "
-        f"within {GAIN_POINTS:g} points determines it: the data do not fix the steady state",
+        f"{lost[0].finding()}; no candidate within {GAIN_POINTS:g} points determines it: "
+        "the data do not fix the steady state",
     )

@@ -42,7 +42,6 @@ thirds and scored on the first third), and folds scored backward in time were th
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -54,7 +53,7 @@ from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
 from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
-from clpc.lpc.choice import GUARD, choose, guarded, oe_lead, tier
+from clpc.lpc.choice import choose, guarded
 from clpc.lpc.comparison import (
     FAMILIES,
     candidate,
@@ -67,12 +66,13 @@ from clpc.lpc.comparison import (
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
 from clpc.lpc.gain_choice import prefer_determined_gain
+from clpc.lpc.reasons import why
 from clpc.lpc.screen import screen
-from clpc.lpc.search_space import search_space
+from clpc.lpc.search_space import excited_order, search_space
 from clpc.model import LinearModel, ModelError
 from clpc.model.structure import Structure, check_mode, default_mode
 
-__all__ = ["ESTIMATORS", "Identification", "identify", "pct"]
+__all__ = ["ESTIMATORS", "Identification", "identify"]
 
 #: Estimator names, as ``identify(estimator=...)`` and ``clpc identify --estimator`` take them.
 ESTIMATORS = ("auto", "lpc", "arx", "oe")
@@ -226,7 +226,11 @@ def identify(
     check_mode(mode, data.n_inputs, data.n_outputs)
     folds = rolling_origin(data, validation_fraction)
     blocks = data.n_inputs if mode == "miso" else 1
-    space = search_space(folds, (order, na, nb, nk), (max_order, max_delay), blocks)
+    if isinstance(order, str) and order != "auto":
+        raise ValueError(f"order must be an int or 'auto'; got {order!r}.")
+    most = max_order if order == "auto" else int(order)
+    excited = excited_order(data.u, 2 * max(most, na or 0, nb or 0) + 1, data.experiments)
+    space = search_space(folds, (order, na, nb, nk), (max_order, max_delay), blocks, excited)
     say(f"structure screen: {len(space.structures)} structures by least squares")
     scr = screen(folds, space.structures, mode)
     short = [scr.structures[i] for i in scr.shortlist(shortlist)]
@@ -260,7 +264,7 @@ def identify(
         eiv: EivCheck | None = check_eiv(data, oe_model)
     except (ModelError, DataError, np.linalg.LinAlgError):
         eiv = None
-    parts = [_why(rows, (first, picks), estimator, (k, validation_fraction), data.output_names)]
+    parts = [why(rows, (first, picks), estimator, (k, validation_fraction), data.output_names)]
     if gain_note:
         parts.append(gain_note)
     parts.append(space.describe(scr, short))
@@ -304,86 +308,3 @@ def _candidates(
             if name == "oe" and model is not None:
                 last_oe[s] = model
     return rows, last_oe
-
-
-def _why(
-    rows: list[dict[str, Any]],
-    choice: tuple[list[int], list[int]],
-    estimator: str,
-    opts: tuple[int, float],
-    names: tuple[str, ...],
-) -> str:
-    """The choice in words.
-
-    ``choice``: the first picks and those kept after the refits; ``opts``: the horizon ``k``
-    and ``validation_fraction``.
-    """
-    k, fraction = opts
-    parts = []
-    lead = [oe_lead(rows, i) for i in choice[1]]
-    for j, (i0, i) in enumerate(zip(*choice, strict=True)):
-        r = rows[i]
-        what = f"{r['estimator'].upper()} (na {r['na']}, nb {r['nb']}, nk {r['nk']})"
-        out = f"output {names[j]}: " if len(names) > 1 else ""
-        each = ", ".join(pct(v) for v in r["windows"])
-        fits = (
-            f"held-out free run {pct(r['free_run'])} (mean over the origins 1/2, 2/3, "
-            f"{1 - fraction:.3g}: {each}), {k}-step {pct(r['kstep'])}"
-        )
-        others = [
-            f"{x['estimator'].upper()} {_fmt(x)}"
-            for x in rows
-            if x is not r and key(x) == key(r) and x["output"] == r["output"]
-        ]
-        level = tier(r)
-        if estimator != "auto":
-            how = "as asked"
-        elif i != i0:
-            how = (
-                f"{rows[i0]['estimator'].upper()} did better held out but its refit on the "
-                "whole record is unstable; the next best"
-            )
-        elif level == 0 and (oe := lead[j]) is not None:
-            d, se, top = oe
-            how = (
-                f"OE kept: the best stable held-out free run, {top['estimator'].upper()}'s "
-                f"{pct(top['free_run'])}, leads it by {d:.2f} "
-                f"points, not more than the standard error of the lead over the origins "
-                f"({se:.2f})"
-            )
-        elif level == 0:
-            how = (
-                "the best held-out free run among the usable candidates (stable or "
-                f"integrating, within {GUARD:g} points of least squares at every origin)"
-            )
-        elif level == 1:
-            how = (
-                f"every candidate falls more than {GUARD:g} points below least squares at "
-                "some origin; the best of them, not a good model"
-            )
-        else:
-            how = "every candidate is unstable or diverges; the least bad, not a good model"
-        parts.append(f"{out}{what}, {how} ({fits}; {', '.join(others)})")
-    unstable = sorted(
-        {
-            f"{x['estimator'].upper()} na={x['na']} nb={x['nb']} nk={x['nk']}"
-            for x in rows
-            if x["stability"] == "unstable"
-        }
-    )
-    text = "; ".join(parts)
-    return text + (f"; unstable at an origin: {', '.join(unstable)}" if unstable else "")
-
-
-def _fmt(row: dict[str, Any]) -> str:
-    """A candidate's held-out free run in a few characters."""
-    if row["stability"] == "no model":
-        return "no model"
-    return pct(row["free_run"]) + (" (unstable)" if row["stability"] == "unstable" else "")
-
-
-def pct(value: float) -> str:
-    """A fit % for people: ``84.2 %``, ``-3.1e+05 %`` or ``diverges``."""
-    if not math.isfinite(value):
-        return "diverges"
-    return f"{value:.1f} %" if abs(value) < 1e4 else f"{value:.1e} %"
