@@ -11,7 +11,7 @@ from scipy import signal
 import clpc
 from clpc.lpc import choice, comparison, reasons
 from clpc.lpc.comparison import FAMILIES
-from clpc.lpc.eiv import RATIO, check_eiv, exact_input_tls
+from clpc.lpc.eiv import MIN_RELATIVE, RATIO, check_eiv, exact_input_tls
 from clpc.lpc.screen import screen
 
 A = np.array([1.0, -1.5, 0.7])
@@ -195,9 +195,14 @@ def test_eiv_check_flags_output_only_noise_and_not_equal_noise():
         eiv = clpc.as_iodata(*_record(20 + seed, "eiv"))
         check = check_eiv(eiv, clpc.OE(order=2).fit(eiv))
         assert not check.violated and check.ratio[0] < RATIO, check.reason
+        # the words follow the numbers: a material difference is named, and why it is no sign
+        differ = check.lpc_distance[0] >= MIN_RELATIVE
+        assert ("but it is only" in check.reason) == differ, check.reason
+        assert ("LPC agrees with OE" in check.reason) == (not differ), check.reason
     clean = clpc.as_iodata(*_record(30, "none"))
     check = check_eiv(clean, clpc.OE(order=2).fit(clean))
     assert not check.violated and check.lpc_distance[0] < 1e-8
+    assert "agrees with OE within 0.0 %" in check.reason
 
 
 def test_exact_input_tls_is_consistent_and_is_lpc_with_no_input_noise():

@@ -143,20 +143,26 @@ def check_eiv(
     flagged = (ratio >= RATIO) & (rel >= MIN_RELATIVE)
     j = int(np.argmax(np.where(flagged, ratio, -1.0))) if flagged.any() else int(np.argmax(rel))
     name = f" (output {oe_model.output_names[j]})" if oe_model.n_outputs > 1 else ""
-    evidence = (
-        f"LPC is {ratio[j]:.2f} times as far from the output-error fit as the exact-input "
-        f"total least squares is{name} (threshold {RATIO:g}), and differs from it by "
-        f"{100 * rel[j]:.1f} % of its parameter norm (threshold {100 * MIN_RELATIVE:g} %)"
-    )
+    far = f"{ratio[j]:.2f} times as far from the output-error fit as the exact-input total "
+    far += f"least squares is{name} (threshold {RATIO:g})"
+    apart = f"{100 * rel[j]:.1f} % of OE's parameter norm (threshold {100 * MIN_RELATIVE:g} %)"
     if flagged.any():
         reason = (
-            "the errors-in-variables assumption of LPC looks violated: "
-            + evidence
-            + ". That is what exact inputs with noise on the output only predict; prefer "
-            "OE (or least squares) on this record."
+            f"the errors-in-variables assumption of LPC looks violated: LPC is {far}, and "
+            f"differs from OE by {apart}. That is what exact inputs with noise on the output "
+            "only predict; prefer OE (or least squares) on this record."
+        )
+    elif rel[j] >= MIN_RELATIVE:  # they differ, but not in output-only noise's pattern
+        reason = (
+            f"no sign that LPC's errors-in-variables assumption is violated: LPC differs "
+            f"from OE by {apart}, but it is only {far}; the exact-input solution disagrees "
+            "with OE as well, which output-only noise would not make it do"
         )
     else:
-        reason = "no sign that LPC's errors-in-variables assumption is violated: " + evidence
+        reason = (
+            f"no sign that LPC's errors-in-variables assumption is violated: LPC agrees with "
+            f"OE within {apart}"
+        )
     return EivCheck(ratio, rel, bool(flagged.any()), reason)
 
 
