@@ -84,8 +84,8 @@ def candidate(
 
     OE starts each later origin from the previous origin's optimum (``initial``, no other
     start): the origins share most of their samples, so the optimum moves little and the
-    search converges in a few steps (about 5x fewer evaluations than from the closed-form
-    starts).
+    search converges sooner (on a 3,000-sample 4th-order record: 45-49 evaluations and
+    0.08 s against 110-118 and 0.4-0.7 s from the closed-form starts).
     """
     folds, k = where
     n_out = folds[0][0].n_outputs
