@@ -133,14 +133,17 @@ def test_a_catastrophic_origin_disqualifies_a_better_mean():
             "note": "",
         }  # fmt: skip
 
-    rows = [row("arx", [80, 80, 85]), row("lpc", [99, 99, 60]), row("oe", [81, 80, 84])]
-    # LPC's mean (86.0) is the best, but at the last origin it is 25 points below ARX's
+    rows = [row("arx", [60, 60, 65]), row("lpc", [99, 99, 10]), row("oe", [62, 61, 64])]
+    # LPC's mean (69.3) is the best, but at the last origin it is 55 points below ARX's
     choice.guarded(rows, {"y": rows[0]["windows"]})
     assert [r["guard"] for r in rows] == [True, False, True]
-    assert "origin 3: free run 60.0 %" in rows[1]["note"] and "85.0 %" in rows[1]["note"]
+    assert "origin 3: free run 10.0 %" in rows[1]["note"] and "65.0 %" in rows[1]["note"]
     assert choice.tier(rows[1]) == 1
     (_, picks) = choice.choose(rows, "auto", ("y",))
-    assert rows[picks[0]]["estimator"] == "oe"  # OE within one standard error of ARX
+    assert rows[picks[0]]["estimator"] == "oe"
+    rows[1]["windows"] = [99, 99, 16]  # 49 points below: within the guard, and the best mean
+    choice.guarded(rows, {"y": rows[0]["windows"]})
+    assert rows[1]["guard"] and choice.tier(rows[1]) == 0
 
 
 def test_an_integrator_is_one_tier_either_side_of_one():

@@ -43,7 +43,7 @@ __all__ = [
 #: Points of free-run fit a structure with fewer parameters may give away.
 PARSIMONY = 1.0
 #: Points below the reference's free run, at any one origin, that disqualify a candidate.
-GUARD = 20.0
+GUARD = 50.0
 
 
 def tier(row: dict[str, Any]) -> int:
