@@ -43,7 +43,7 @@ thirds and scored on the first third), and folds scored backward in time were th
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -51,7 +51,7 @@ from threadpoolctl import threadpool_limits
 
 from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
-from clpc.data import DataError, as_iodata
+from clpc.data import DataError, IOData, as_iodata
 from clpc.lpc import heldout
 from clpc.lpc.choice import choose, guarded
 from clpc.lpc.comparison import (
@@ -278,6 +278,26 @@ def _is(row: dict[str, Any], name: str, structure: Structure) -> bool:
     return row["estimator"] == name and key(row) == (structure.na, structure.nb, structure.nk)
 
 
+def _subspace_structures(data: IOData, short: list[Structure], mode: str) -> list[Structure]:
+    """The subspace candidates: its own order choice and the shortlist's state dimensions.
+
+    ``Subspace(order="auto")`` on ``data`` (the last origin's fitted part) with and without
+    feedthrough (its singular values and held-out check, :mod:`clpc.lpc.subspace_order`),
+    then the state dimension each shortlisted structure's lags need (``max(na, nb + 1)``,
+    with its delay); each structure once.
+    """
+    own = []
+    for nk in (0, max(short[0].nk, 1)):
+        try:
+            est = make("subspace", subspace_structure(1, nk), mode)
+            fitted = replace(est, order="auto").fit(data)
+            own.append(subspace_structure(fitted.structure.na, nk))
+        except (ModelError, DataError, np.linalg.LinAlgError):
+            continue
+    shaped = [subspace_structure(max(s.na, s.nb + 1), s.nk) for s in short]
+    return list(dict.fromkeys(own + shaped))
+
+
 def _candidates(
     folds: list[Any],
     short: list[Structure],
@@ -296,10 +316,8 @@ def _candidates(
     shapes = ", ".join(f"na={s.na} nb={s.nb} nk={s.nk}" for s in short)
     for name in FAMILIES:
         where = short
-        if name == "subspace":  # the state dimension that holds each structure's lags
-            where = list(
-                dict.fromkeys(subspace_structure(max(s.na, s.nb + 1), s.nk) for s in short)
-            )
+        if name == "subspace":
+            where = _subspace_structures(folds[-1][0], short, mode)
             shapes = ", ".join(f"order {s.na} nk={s.nk}" for s in where)
         say(f"{name.upper()}: {shapes} at {len(folds)} origins")
         for s in where:
