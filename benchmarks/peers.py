@@ -32,7 +32,8 @@ Methods:
    include_offset=False)`` (the model without its constant), for information only.
 2. ``clpc identify auto``: ``clpc.identify(est, order="auto", nk="auto")``, only if it
    finishes within ``AUTO_LIMIT`` seconds on the record (else the row says it was skipped);
-   ``--no-clpc-auto`` leaves it out.
+   left out when identify's defaults are already ``order="auto"`` and ``nk="auto"`` (the
+   same call), or with ``--no-clpc-auto``.
 3. SIPPY (``sippy_unipi``), ``system_identification`` with ``IC="AICc"`` (its
    information-criterion mode; AICc in every peer whose criterion we set):
 
@@ -97,6 +98,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import io
 import math
 import os
@@ -582,9 +584,15 @@ def run_frols(rec: Record) -> list[Outcome]:
 
 
 # ====================================================================== the run
+def defaults_are_auto() -> bool:
+    """Whether ``clpc.identify`` already chooses order and delay by default."""
+    params = inspect.signature(clpc.identify).parameters
+    return all(p in params and params[p].default == "auto" for p in ("order", "nk"))
+
+
 def methods(args: argparse.Namespace) -> list[tuple[str, Callable[[Record], list[Outcome]]]]:
     out: list[tuple[str, Callable[[Record], list[Outcome]]]] = [(CLPC, run_clpc)]
-    if not args.no_clpc_auto:
+    if not args.no_clpc_auto and not defaults_are_auto():
         out.append((CLPC_AUTO, run_clpc_auto))
     out += [
         ("SIPPY N4SID", sippy_ss("N4SID")),
@@ -750,22 +758,29 @@ def summary(tables: list[Table]) -> list[str]:
     return lines
 
 
+def identify_defaults() -> str:
+    params = inspect.signature(clpc.identify).parameters
+    keys = ("estimator", "order", "nk", "max_order", "max_delay", "mimo")
+    return ", ".join(f"{k}={params[k].default!r}" for k in keys if k in params)
+
+
 def git_commit() -> str:
+    """The last commit that changed clpc's sources, and the checkout's HEAD."""
     root = Path(clpc.__file__).resolve().parents[2]
-    try:
+
+    def git(*cmd: str) -> str:
         out = subprocess.run(
-            ["git", "-C", str(root), "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            check=True,
+            ["git", "-C", str(root), *cmd], capture_output=True, text=True, check=True
         )
-        dirty = subprocess.run(
-            ["git", "-C", str(root), "status", "--porcelain", "--", "src"],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout.strip()
-        return out.stdout.strip() + (" + uncommitted changes in src" if dirty else "")
+        return out.stdout.strip()
+
+    try:
+        src, head = (
+            git("log", "-1", "--format=%h", "--", "src"),
+            git("rev-parse", "--short", "HEAD"),
+        )
+        dirty = " + uncommitted changes in src" if git("status", "--porcelain", "--", "src") else ""
+        return f"{src}{dirty} (sources; checkout at {head})"
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 
@@ -824,6 +839,13 @@ def main(argv: list[str] | None = None) -> None:
         f"{time.perf_counter() - t0:.0f} s -->",
         "",
         f"clpc at {git_commit()}; {versions()}.",
+        "",
+        f"{CLPC}: `clpc.identify(est)`, defaults {identify_defaults()}"
+        + (
+            f"; no {CLPC_AUTO!r} row: the defaults are order and delay 'auto' already."
+            if defaults_are_auto()
+            else "."
+        ),
         "",
         f"{len(tables)} targets ({len(names)} records); 60/40 split (cascaded_tanks: its own "
         "records), estimation mean removed; free run from zero state, validation samples "
