@@ -87,11 +87,14 @@ or ahead, the worst shortfall, and whether identify's mean beats the best peer m
 per-target tables show the raw numbers.
 
 Usage (the peers are not dependencies of clpc: ``pip install -e ".[peers]"`` in a venv of
-its own; about 20 min on the 2-core machine at load average 5-6, of which identify auto is
-about 8 min: ``--no-clpc-auto`` for a quicker run)::
+its own). About 4 min on the shared 2-core machine at load average 3 with identify's
+defaults automatic (no auto row); about 20 min at load average 5-6 with the auto row of
+clpc before those defaults (identify auto 40-60 s per record, ``--no-clpc-auto`` to skip
+it). ``identify`` limits itself to one BLAS thread; ``OPENBLAS_NUM_THREADS=1`` gives the
+peers the same. The Markdown starts at heading level 3 (to sit under a section)::
 
-    python benchmarks/peers.py [--records dryer exchanger] [--markdown FILE]
-        [--no-clpc-auto] [--full-grids] [--peer-limit SECONDS]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/peers.py [--records dryer exchanger]
+        [--markdown FILE] [--no-clpc-auto] [--full-grids] [--peer-limit SECONDS]
 """
 
 from __future__ import annotations
@@ -660,7 +663,7 @@ def pole_text(v: float) -> str:
 
 def per_target(table: Table) -> list[str]:
     lines = [
-        f"### {table.target} ({table.n_est} estimation / {table.n_val} validation samples)",
+        f"#### {table.target} ({table.n_est} estimation / {table.n_val} validation samples)",
         "",
         "| method | fit % | RMS | structure | max abs pole | fit s |",
         "|---|---|---|---|---|---|",
@@ -684,7 +687,7 @@ def floored(r: Row) -> float:
 
 def summary(tables: list[Table]) -> list[str]:
     lines = [
-        "## Summary",
+        "### Summary",
         "",
         f"Best peer: the highest validation fit among the peers (not {CLPC!r}, not the oracle).",
         "",
@@ -853,7 +856,7 @@ def main(argv: list[str] | None = None) -> None:
         "",
     ]
     body = [line for t in tables for line in per_target(t)]
-    text = "\n".join([*head, *summary(tables), "## Per target", "", *body])
+    text = "\n".join([*head, *summary(tables), "### Per target", "", *body])
     print(text)
     if args.markdown:
         args.markdown.write_text(text + "\n", encoding="utf-8")
