@@ -622,7 +622,7 @@ def run_record(rec: Record, args: argparse.Namespace) -> list[Table]:
         try:
             with limit(args.peer_limit if is_peer(name) else 0):
                 outcomes = run(rec)
-        except (Exception, PeerTimeout) as exc:
+        except (Exception, SystemExit) as exc:  # SIPPY refuses with sys.exit
             outcomes = failed(rec, exc)
         print(
             f"  {rec.name}: {name} {time.perf_counter() - t0:.1f} s",
