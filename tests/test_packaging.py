@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import importlib.metadata
 import re
 import tomllib
@@ -63,3 +64,23 @@ def test_no_page_installs_clpc_from_an_index():
     from_index = re.compile(r"pip install\s+(-\S+\s+)*['\"]?clpc\b")
     offenders = [str(p.relative_to(ROOT)) for p in pages if from_index.search(p.read_text())]
     assert offenders == []
+
+
+def test_the_peers_of_the_benchmark_are_never_dependencies_of_the_package():
+    """``benchmarks/peers.py``'s tools: an extra for that script, imported by no package file."""
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    peers = {"sippy_unipi", "nfoursid", "sysidentpy"}
+    assert set(meta["project"]["optional-dependencies"]["peers"]) == peers
+    deps = meta["project"]["dependencies"]
+    named = {d.split(">")[0].split("=")[0].split("[")[0].strip() for d in deps}
+    assert not named & peers
+    for package in ("clpc", "clpc_paper"):
+        for path in (ROOT / "src" / package).rglob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Import):
+                    roots = {a.name.split(".")[0] for a in node.names}
+                elif isinstance(node, ast.ImportFrom) and not node.level:
+                    roots = {(node.module or "").split(".")[0]}
+                else:
+                    continue
+                assert not roots & peers, f"{path.relative_to(ROOT)} imports {roots & peers}"
