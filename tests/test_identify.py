@@ -169,12 +169,12 @@ def test_an_integrating_plant_is_chosen_by_its_scores():
     y0 = signal.lfilter([0.0, 0.1, 0.05], np.convolve([1, -1], [1, -0.6]), u)  # 1/(z-1)
     y = y0 + 0.02 * y0.std() * rng.standard_normal(u.size)
     found = clpc.identify(u, y, order=2, nk=0)
-    poles = {r["estimator"]: r["max_pole"] for r in found.table}
+    poles = {r["estimator"]: r["max_pole"] for r in found.table if comparison.key(r) == (2, 2, 0)}
     assert min(poles.values()) < 1 < max(poles.values()), poles  # both sides of 1
     tol = clpc.lpc.heldout.UNIT_CIRCLE_TOL
     assert all(abs(p - 1) <= tol for p in poles.values()), poles
     usable = [r for r in found.table if choice.tier(r) == 0]
-    assert len(usable) == 3
+    assert {"arx", "lpc", "oe"} <= {r["estimator"] for r in usable}
     chosen = next(r for r in found.table if r["chosen"])
     best = max(usable, key=lambda r: r["free_run"])
     lead, se = choice.oe_margin(best, next(r for r in usable if r["estimator"] == "oe"))
