@@ -97,7 +97,7 @@ def cli() -> None:
     \b
     Examples:
       clpc datasets
-      clpc identify dryer.csv --input u --output y --order auto --dt 0.08
+      clpc identify dryer.csv --input u --output y --dt 0.08
       clpc track run.csv --input u --output y --out results/
       my_daq | clpc stream --window-size 201 --cluster-size 12
     """  # noqa: D301

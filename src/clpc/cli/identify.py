@@ -1,4 +1,4 @@
-"""``clpc identify``: batch LPC on a file."""
+"""``clpc identify``: a model of a file, structure and estimator chosen (or LPC alone)."""
 
 from __future__ import annotations
 

@@ -15,7 +15,8 @@ least-squares model of the screen's choice fitted on the first half,
   independently) as least squares, in microseconds each; the ``shortlist`` best go on (the
   fewest coefficients within :data:`clpc.lpc.screen.PARSIMONY` of the best first).
 * **Candidates** (:mod:`clpc.lpc.comparison`): least squares, LPC and OE at each
-  shortlisted structure (OE started at each later origin from the previous optimum).
+  shortlisted structure (OE started at each later origin from the previous optimum), and
+  subspace (PO-MOESP) at the state dimension each needs.
 * **Choice**, per output (:mod:`clpc.lpc.choice`): among the usable candidates (stable or
   integrating within :data:`clpc.lpc.heldout.UNIT_CIRCLE_TOL`, never more than
   :data:`clpc.lpc.choice.GUARD` points below the screen's least-squares choice at any
@@ -98,7 +99,7 @@ class Identification:
     reason : str
         Why this model, in words (the screen, the choice, the errors-in-variables check).
     estimators : tuple of str
-        The chosen estimator per output (``"lpc"``, ``"arx"`` or ``"oe"``).
+        The chosen estimator per output (``"lpc"``, ``"arx"``, ``"oe"`` or ``"subspace"``).
     structure : Structure
         The chosen orders and delay.
     horizon : int

@@ -1,4 +1,4 @@
-"""The identify report: an HTML page of one batch LPC fit (``clpc identify --report``).
+"""The identify report: an HTML page of one batch fit (``clpc identify --report``).
 
 Read top down: what the record decides (the identifiability findings in a box, the DC gains
 +- one sigma, the dominant poles), the estimator comparison when there was one (its table

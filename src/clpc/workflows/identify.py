@@ -1,4 +1,4 @@
-"""Batch LPC on a file: identify a model (its order given or selected)."""
+"""Identify a model from a file: structure and estimator chosen, or the paper's LPC alone."""
 
 from __future__ import annotations
 
@@ -58,9 +58,10 @@ class IdentifySettings:
         coefficients per input; MATLAB's ``arx`` nb is clpc's ``nb + 1``).
     estimator : {"auto", "arx", "oe", "lpc"}
         ``"auto"`` (default): structure and estimator chosen on held-out data among least
-        squares, LPC and output error (:func:`clpc.identify`); ``"arx"`` or ``"oe"``: the
-        same search, keeping that estimator; ``"lpc"``: the paper's LPC alone (its order
-        by ``criterion``, its delay by :func:`clpc.lpc.select_delay`), no comparison.
+        squares, LPC, output error and subspace (:func:`clpc.identify`); ``"arx"`` or
+        ``"oe"``: the same search, keeping that estimator; ``"lpc"``: the paper's LPC alone
+        (its order by ``criterion``, its delay by :func:`clpc.lpc.select_delay`), no
+        comparison.
     """
 
     record: RecordSpec
@@ -160,7 +161,7 @@ class IdentifyResult:
 def identify_file(
     settings: IdentifySettings, progress: Callable[[str], None] | None = None
 ) -> IdentifyResult:
-    """Identify a linear model ``-B(z)/A(z)`` from a record with batch LPC.
+    """Identify a linear model ``-B(z)/A(z)`` from a record (:func:`clpc.identify`, or LPC alone).
 
     Parameters
     ----------
@@ -172,7 +173,7 @@ def identify_file(
     Returns
     -------
     IdentifyResult
-        Model, summary and order selection.
+        Model, summary, and the estimator comparison or (LPC alone) the order selection.
 
     Raises
     ------
