@@ -25,8 +25,8 @@ def test_by_default_everything_is_chosen_and_the_table_printed():
     assert "estimator comparison" in out
     lib = clpc.identify(ds.load("dryer"))
     s = lib.structure
-    for name in ("LPC", "ARX", "OE "):
-        assert f"{name} na={s.na} nb={s.nb} nk={s.nk}" in out
+    for name in ("LPC", "ARX", "OE"):
+        assert f"{name:<8} na={s.na} nb={s.nb} nk={s.nk}" in out
     assert out.count("<- chosen") == 1
     assert "reason:" in out and "errors-in-variables" in out
     assert "structures screened: 660" in out

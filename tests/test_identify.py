@@ -86,6 +86,14 @@ def test_never_unstable_when_a_stable_candidate_exists():
     assert found.model.is_stable
 
 
+def test_a_given_order_is_the_order_of_every_candidate():
+    u, y = _record(13, "output", n=800)
+    found = clpc.identify(u, y, order=1)
+    assert {r["na"] for r in found.table} == {1} and found.structure.na == 1
+    assert "subspace" in {r["estimator"] for r in found.table}
+    assert "; )" not in found.reason and "()" not in found.reason
+
+
 def test_delay_auto_finds_the_delay():
     found = {}
     for seed in range(3, 8):

@@ -86,7 +86,7 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
         mark = "  <- chosen" if r["chosen"] else ""
         note = f"  ({r['note']})" if r["note"] else ""
         lines.append(
-            f"  {r['estimator'].upper():<3} na={r['na']} nb={r['nb']} nk={r['nk']}{out}: free "
+            f"  {r['estimator'].upper():<8} na={r['na']} nb={r['nb']} nk={r['nk']}{out}: free "
             f"run {pct(r['free_run'])}, {found.horizon}-step {pct(r['kstep'])}, "
             f"{r['stability']}{mark}{note}"
         )
@@ -157,9 +157,10 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     type=click.Choice(ESTIMATORS),
     default="auto",
     show_default=True,
-    help="auto: screen the structures by least squares, compare least squares (arx), LPC and "
-    "output error (oe) on held-out data, print the table and the reason, keep the best; "
-    "arx or oe: the same, keeping that one; lpc: the paper's LPC alone, no comparison.",
+    help="auto: screen the structures by least squares, compare least squares (arx), LPC, "
+    "output error (oe) and subspace models on held-out data, print the table and the reason, "
+    "keep the best; arx, oe or subspace: the same, keeping that one; lpc: the paper's LPC "
+    "alone, no comparison.",
 )
 @method_option()
 @click.option(

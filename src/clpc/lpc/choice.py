@@ -36,6 +36,7 @@ __all__ = [
     "guarded",
     "oe_lead",
     "oe_margin",
+    "pct",
     "ranked",
     "tier",
 ]
@@ -79,9 +80,26 @@ def guarded(rows: list[dict[str, Any]], reference: dict[str, list[float]]) -> No
         if low.any():
             o = int(np.argmax(low))
             row["note"] = (
-                f"origin {o + 1}: free run {own[o]:.1f} %, more than {GUARD:g} points below "
-                f"the least-squares reference's {ref[o]:.1f} %: not chosen"
+                f"origin {o + 1}: free run {pct(own[o])}, more than {GUARD:g} points below "
+                f"the least-squares reference's {pct(ref[o])}: not chosen"
             )
+
+
+def pct(value: float) -> str:
+    """A fit % for people: ``84.2 %``, ``-3.1e+05 %`` or ``diverges``.
+
+    Parameters
+    ----------
+    value : float
+        Fit [%].
+
+    Returns
+    -------
+    str
+    """
+    if not math.isfinite(value):
+        return "diverges"
+    return f"{value:.1f} %" if abs(value) < 1e4 else f"{value:.1e} %"
 
 
 def oe_margin(best: dict[str, Any], oe: dict[str, Any]) -> tuple[float, float]:

@@ -6,10 +6,9 @@ and every threshold from :mod:`clpc.lpc.choice`: the words match the table.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
-from clpc.lpc.choice import GUARD, oe_lead, tier
+from clpc.lpc.choice import GUARD, oe_lead, pct, tier
 from clpc.lpc.comparison import key
 
 __all__ = ["pct", "why"]
@@ -86,7 +85,8 @@ def why(
             )
         else:
             how = "every candidate is unstable or diverges; the least bad, not a good model"
-        parts.append(f"{out}{what}, {how} ({fits}; {', '.join(others)})")
+        rivals = f"; {', '.join(others)}" if others else ""
+        parts.append(f"{out}{what}, {how} ({fits}{rivals})")
     unstable = sorted(
         {
             f"{x['estimator'].upper()} na={x['na']} nb={x['nb']} nk={x['nk']}"
@@ -103,20 +103,3 @@ def _fmt(row: dict[str, Any]) -> str:
     if row["stability"] == "no model":
         return "no model"
     return pct(row["free_run"]) + (" (unstable)" if row["stability"] == "unstable" else "")
-
-
-def pct(value: float) -> str:
-    """A fit % for people: ``84.2 %``, ``-3.1e+05 %`` or ``diverges``.
-
-    Parameters
-    ----------
-    value : float
-        Fit [%].
-
-    Returns
-    -------
-    str
-    """
-    if not math.isfinite(value):
-        return "diverges"
-    return f"{value:.1f} %" if abs(value) < 1e4 else f"{value:.1e} %"

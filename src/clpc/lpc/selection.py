@@ -76,7 +76,7 @@ from clpc.model.structure import Structure, check_mode, default_mode
 __all__ = ["ESTIMATORS", "Identification", "identify"]
 
 #: Estimator names, as ``identify(estimator=...)`` and ``clpc identify --estimator`` take them.
-ESTIMATORS = ("auto", "lpc", "arx", "oe")
+ESTIMATORS = ("auto", "lpc", "arx", "oe", "subspace")
 
 
 @compact_repr
@@ -239,7 +239,8 @@ def identify(
         lowest = make("arx", short[0], mode).fit(folds[0][0])
         k = heldout.horizon(lowest, folds[0][1].n_samples)
     k = check_int(k, "k", 1)
-    rows, last_oe = _candidates(folds, short, (mode, k), say)
+    automatic = order == "auto" and na is None and nb is None
+    rows, last_oe = _candidates(folds, short, (mode, k, automatic), say)
     # the reference: least squares at the screen's choice (the first shortlisted structure)
     guarded(rows, {r["output"]: r["windows"] for r in rows if _is(r, "arx", short[0])})
     where, first = choose(rows, estimator, data.output_names)
@@ -279,14 +280,19 @@ def _is(row: dict[str, Any], name: str, structure: Structure) -> bool:
     return row["estimator"] == name and key(row) == (structure.na, structure.nb, structure.nk)
 
 
-def _subspace_structures(data: IOData, short: list[Structure], mode: str) -> list[Structure]:
+def _subspace_structures(
+    data: IOData, short: list[Structure], mode: str, automatic: bool
+) -> list[Structure]:
     """The subspace candidates: its own order choice and the shortlist's state dimensions.
 
-    ``Subspace(order="auto")`` on ``data`` (the last origin's fitted part) with and without
-    feedthrough (its singular values and held-out check, :mod:`clpc.lpc.subspace_order`),
-    then the state dimension each shortlisted structure's lags need (``max(na, nb + 1)``,
-    with its delay); each structure once.
+    ``automatic`` (the orders are searched): ``Subspace(order="auto")`` on ``data`` (the
+    last origin's fitted part) with and without feedthrough (its singular values and
+    held-out check, :mod:`clpc.lpc.subspace_order`), then the state dimension each
+    shortlisted structure's lags need (``max(na, nb + 1)``, with its delay); otherwise
+    (an order given) the shortlist's ``na`` only. Each structure once.
     """
+    if not automatic:
+        return list(dict.fromkeys(subspace_structure(s.na, s.nk) for s in short))
     own = []
     for nk in (0, max(short[0].nk, 1)):
         try:
@@ -302,14 +308,14 @@ def _subspace_structures(data: IOData, short: list[Structure], mode: str) -> lis
 def _candidates(
     folds: list[Any],
     short: list[Structure],
-    opts: tuple[str, int],
+    opts: tuple[str, int, bool],
     say: Callable[[str], None],
 ) -> tuple[list[dict[str, Any]], dict[Structure, LinearModel]]:
     """Every estimator at every shortlisted structure, scored at the origins.
 
     Returns the rows (``n_params`` added) and each structure's OE fit at the last origin.
     """
-    mode, k = opts
+    mode, k, automatic = opts
     n_in = folds[0][0].n_inputs
     blocks = n_in if mode == "miso" else 1
     rows: list[dict[str, Any]] = []
@@ -318,7 +324,7 @@ def _candidates(
     for name in FAMILIES:
         where = short
         if name == "subspace":
-            where = _subspace_structures(folds[-1][0], short, mode)
+            where = _subspace_structures(folds[-1][0], short, mode, automatic)
             shapes = ", ".join(f"order {s.na} nk={s.nk}" for s in where)
         say(f"{name.upper()}: {shapes} at {len(folds)} origins")
         for s in where:
