@@ -404,6 +404,7 @@ def test_the_report_opens_with_what_the_record_decides(records, tmp_path):
     found = clpc.identify(clpc.as_iodata(*sine_record(8), dt=0.01), order=2, nk=1)
     for row in found.table:
         assert row["estimator"].upper() in page.cells
+        assert f"na={row['na']} nb={row['nb']} nk={row['nk']}" in page.cells
         assert f"{row['free_run']:.2f} %" in page.cells
     assert "NO" in page.cells  # the gain is not determined
     html = (tmp_path / "report.html").read_text(encoding="utf-8")

@@ -79,7 +79,7 @@ def _decided_section(model: LinearModel) -> tuple[Section, list[str]]:
         f"(Ljung 1999, section 13.2), and each DC gain at least {GAIN_SIGMAS:g} standard "
         "deviation (delta method) from 0, unless that deviation is at most "
         f"{GAIN_SCALE_FRACTION:g} std(y)/std(u) (then the gain is decided to be small). "
-        + " ".join(said)
+        + " ".join(x[:1].upper() + x[1:] for x in said)
     )
     html_parts = [
         table_html(gains, "DC gains"),
@@ -113,7 +113,7 @@ def _comparison_section(comparison: Any) -> Section:
         rows.append(
             [
                 str(r["estimator"]).upper(),
-                f"N={r['order']} nk={r['nk']}",
+                f"na={r['na']} nb={r['nb']} nk={r['nk']}",
                 *([r["output"]] if many else []),
                 *(format_fit(w) for w in windows[:n_origins]),
                 format_fit(r["free_run"]),
