@@ -1,9 +1,13 @@
+import errno
+import re
+
 import numpy as np
 import pytest
 
 import clpc
 from clpc import CLPC
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter, trace_columns
+from clpc.core.atomic import OutputError
 from clpc.io import read_table
 
 
@@ -43,23 +47,27 @@ def test_thinned_trace_is_bounded_and_evenly_strided():
         ThinnedTrace(0)
 
 
-def test_a_failed_background_write_is_raised_by_the_next_write_or_close(tmp_path, monkeypatch):
+def test_a_failed_background_write_is_raised_by_the_next_write_and_leaves_no_file(
+    tmp_path, monkeypatch
+):
     pa_csv = pytest.importorskip("pyarrow.csv")
     parts, _ = parts_and_whole()
     calls = []
 
     def broken(table, sink, options):
         calls.append(table.num_rows)
-        raise OSError("disk full")
+        raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(pa_csv, "write_csv", broken)
-    w = TraceWriter(tmp_path / "trace.csv")
+    target = tmp_path / "trace.csv"
+    w = TraceWriter(target)
     w.write(parts[0])  # handed to the writer's thread
-    with pytest.raises(OSError, match="disk full"):
-        w.write(parts[1])  # waits for the first: its error surfaces here, once
+    message = f"cannot write '{target}': No space left on device"
+    with pytest.raises(OutputError, match=re.escape(message)):
+        w.write(parts[1])  # waits for the first: its error surfaces here, naming the file
     assert calls == [len(parts[0])]  # the second part was not handed over
-    w.write(parts[2])
-    with pytest.raises(OSError, match="disk full"):
-        w.close()  # the third failed as well: close says so
-    assert calls == [len(parts[0]), len(parts[2])]
-    w.close()  # closed: nothing more to raise
+    assert list(tmp_path.iterdir()) == []  # the partial file is gone; no trace.csv
+    with pytest.raises(OutputError, match=re.escape(message)):
+        w.write(parts[2])  # the writer is spent: the same error, nothing written
+    w.close()  # discarded: nothing more to raise
+    assert calls == [len(parts[0])] and list(tmp_path.iterdir()) == []

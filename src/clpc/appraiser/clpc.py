@@ -8,12 +8,9 @@ and its transition :class:`clpc.appraiser.state.AppraiserState`, one per record.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 import math
-import os
-import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -37,6 +34,7 @@ from clpc.appraiser.state_schema import (
 )
 from clpc.appraiser.state_schema import field as state_field
 from clpc.appraiser.trace import Trace
+from clpc.core.atomic import atomic_file
 from clpc.core.rules import RobustRule
 from clpc.data.samples import check_spread
 
@@ -353,19 +351,14 @@ class CLPC:
         ----------
         path : str
             Destination file (replaced if it exists).
+
+        Raises
+        ------
+        clpc.core.atomic.OutputError
+            ``path`` is a symbolic link, or writing failed (``path`` is left as it was).
         """
-        target = os.path.abspath(path)
-        fd, tmp = tempfile.mkstemp(
-            prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=os.path.dirname(target)
-        )
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                json.dump(self.state_dict(), fh)
-            os.replace(tmp, target)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
+        with atomic_file(path) as fh:
+            json.dump(self.state_dict(), fh)
 
     @classmethod
     def load(cls, path: str) -> CLPC:

@@ -8,16 +8,18 @@ for figures and summaries (every update until the cap, then every 2nd, 4th, ... 
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.thinned import ThinnedTrace
 from clpc.appraiser.trace import SCALAR_KEYS, Trace
+from clpc.core.atomic import OutputError, atomic_path
 from clpc.data import DataError
 
 __all__ = ["ThinnedTrace", "TraceWriter", "trace_column_list", "trace_columns"]
@@ -113,6 +115,11 @@ class TraceWriter:
     by pyarrow's CSV writer when pyarrow is installed (a C++ loop), else by one ``%``
     format per row.
 
+    The rows go to a temporary file beside ``path`` that is renamed to ``path`` when the
+    writer is closed without an error (:func:`clpc.core.atomic.atomic_path`): a run that
+    fails or is killed leaves no partial trace. A write error (a full disk) is raised as
+    :class:`clpc.core.atomic.OutputError` naming ``path``.
+
     Parameters
     ----------
     path : str or Path
@@ -132,12 +139,29 @@ class TraceWriter:
         self._csv_options: Any = None
         self._pool: ThreadPoolExecutor | None = None
         self._pending: Future[Any] | None = None
+        self._target: contextlib.AbstractContextManager[Path] | None = None
+        self._failed: OutputError | None = None
         self.rows = 0
 
     def write(self, part: Trace) -> None:
         """Append the rows of ``part`` (a trace of consecutive updates)."""
         if not len(part):
             return
+        if self._failed is not None:
+            raise self._failed
+        try:
+            self._write(part)
+        except OSError as exc:
+            raise self._fail(exc) from exc
+        self.rows += len(part)
+
+    def _fail(self, exc: OSError) -> OutputError:
+        """Discard the file after a write error; later writes raise the same error."""
+        self.discard()
+        self._failed = exc if isinstance(exc, OutputError) else OutputError(self.path, exc)
+        return self._failed
+
+    def _write(self, part: Trace) -> None:
         names, cols = trace_column_list(part)
         if self._names is None:
             self._names = names
@@ -153,19 +177,20 @@ class TraceWriter:
             rows = np.column_stack([c.astype(object) for c in cols]).tolist()
             fmt = self._row_format
             self._fh.write("".join([fmt % tuple(r) for r in rows]))
-        self.rows += len(part)
 
     def _open(self, names: list[str], cols: list[np.ndarray]) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._target = atomic_path(self.path)
+        tmp = self._target.__enter__()
         header = (",".join(names) + "\n").encode()
         if self.suffix == ".csv":
             self._pa = _arrow()
             if self._pa is not None:
-                self._fh = self.path.open("wb")
+                self._fh = tmp.open("wb")
                 self._fh.write(header)
                 self._csv_options = self._pa.csv.WriteOptions(include_header=False)
             else:
-                self._fh = self.path.open("w", encoding="utf-8")
+                self._fh = tmp.open("w", encoding="utf-8")
                 self._fh.write(header.decode())
                 formats = ["%d" if _is_integer(c) else "%r" for c in cols]
                 self._row_format = ",".join(formats) + "\n"
@@ -180,7 +205,7 @@ class TraceWriter:
                 for n, c in zip(names, cols, strict=True)
             ]
         )
-        self._writer = pq.ParquetWriter(self.path, schema)
+        self._writer = pq.ParquetWriter(tmp, schema)
 
     def _in_background(self, fn: Callable[..., Any], *args: Any) -> None:
         """Run ``fn(*args)`` in a thread, after the writes before it.
@@ -201,14 +226,40 @@ class TraceWriter:
             pending.result()
 
     def close(self) -> None:
-        """Finish the writes, flush and close the file (an error of a write is raised)."""
+        """Finish the writes, close the file and rename it to :attr:`path`.
+
+        Raises
+        ------
+        OutputError
+            A write failed (the partial file is removed; ``path`` is left as it was).
+        """
         try:
-            self.drain()
-        finally:
-            if self._pool is not None:
-                self._pool.shutdown(wait=True)
-                self._pool = None
+            try:
+                self.drain()
+            finally:
+                self._stop_pool()
+                self._close_files()
+        except OSError as exc:
+            raise self._fail(exc) from exc
+        target, self._target = self._target, None
+        if target is not None:
+            target.__exit__(None, None, None)
+
+    def discard(self) -> None:
+        """Stop writing and remove the partial file (``path`` is left as it was)."""
+        with contextlib.suppress(Exception):
+            self._stop_pool()
+        with contextlib.suppress(Exception):
             self._close_files()
+        target, self._target = self._target, None
+        if target is not None:
+            with contextlib.suppress(Exception):
+                target.__exit__(_Discarded, _Discarded(), None)
+
+    def _stop_pool(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
 
     def _close_files(self) -> None:
         if self._fh is not None:
@@ -221,8 +272,15 @@ class TraceWriter:
     def __enter__(self) -> TraceWriter:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.discard()
+
+
+class _Discarded(Exception):
+    """Thrown into the temporary file's context to remove it."""
 
 
 def _arrow_table(pa: Any, names: list[str], cols: list[np.ndarray]) -> Any:
@@ -238,62 +296,3 @@ def _arrow_table(pa: Any, names: list[str], cols: list[np.ndarray]) -> Any:
         kind = pa.int64() if c.dtype == np.int64 else pa.float64()
         arrays.append(pa.Array.from_buffers(kind, c.size, [None, pa.py_buffer(c)]))
     return pa.Table.from_arrays(arrays, names=names)
-
-
-class ThinnedTrace:
-    """Keep a bounded, evenly thinned copy of a growing trace.
-
-    Parameters
-    ----------
-    max_updates : int
-        Updates are kept one in ``stride``; when more than ``2 * max_updates`` are held the
-        stride doubles and every other kept update is dropped.
-    """
-
-    def __init__(self, max_updates: int = 20_000) -> None:
-        if max_updates < 1:
-            raise ValueError(f"max_updates must be >= 1; got {max_updates}.")
-        self.max_updates = int(max_updates)
-        self.stride = 1
-        self.seen = 0
-        self._parts: list[Trace] = []
-        self._held = 0
-
-    def add(self, part: Trace) -> None:
-        """Take the updates of ``part`` whose running number is a multiple of ``stride``."""
-        n = len(part)
-        if not n:
-            return
-        numbers = self.seen + np.arange(n)
-        self.seen += n
-        keep = np.flatnonzero(numbers % self.stride == 0)
-        if keep.size:
-            self._parts.append(_take(part, keep))
-            self._held += keep.size
-        while self._held > 2 * self.max_updates:
-            self._thin()
-
-    def _thin(self) -> None:
-        merged = Trace.concat(self._parts)
-        # kept updates are numbered 0, s, 2s, ...: keep the multiples of 2s
-        self.stride *= 2
-        merged = _take(merged, np.arange(0, len(merged), 2))
-        self._parts = [merged]
-        self._held = len(merged)
-
-    def trace(self) -> Trace:
-        """The thinned trace (every ``stride``-th update)."""
-        merged = Trace.concat(self._parts)
-        meta = dict(merged.meta, thinned_stride=self.stride, updates_total=self.seen)
-        return replace(merged, meta=meta)
-
-
-def _take(trace: Trace, rows: np.ndarray) -> Trace:
-    return replace(
-        trace,
-        index=trace.index[rows],
-        time=trace.time[rows],
-        rows=trace.rows[rows],
-        not_enough_data=trace.not_enough_data[rows],
-        arrays={k: v[rows] for k, v in trace.arrays.items()},
-    )

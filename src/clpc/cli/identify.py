@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from collections.abc import Callable
@@ -24,6 +25,7 @@ from clpc.cli.options import (
     save_option,
 )
 from clpc.cli.output import echo_json
+from clpc.core.output_folder import OutputFolder
 from clpc.lpc.reasons import pct
 from clpc.lpc.selection import ESTIMATORS
 from clpc.report import format_model_summary, write_identify_report
@@ -200,21 +202,24 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
       clpc identify arm.csv -u u1 -u u2 -y y1 -y y2 --json
       clpc identify dryer.csv -u u -y y --estimator lpc --order 2 --nk 0
     """  # noqa: D301
-    result = identify_file(settings, _progress())
-    if as_json:
-        echo_json(result.summary)
-        return
-    for line in lead_lines(result.summary):  # what the data cannot decide, first
-        click.echo(line)
-    if result.comparison is not None:
-        click.echo("\n".join(_comparison_lines(result)))
-    if result.selection is not None:
-        click.echo(_selection_line(result))
-    click.echo(format_model_summary(result.summary, lead=False))
-    if settings.save:
-        click.echo(f"model saved to {settings.save}")
-    if report:
-        click.echo(f"wrote {_write_report(settings, result, report)}")
+    # the report's folder is locked first: a second run into it is refused before fitting
+    folder = OutputFolder(report, "--report") if report else None
+    with folder if folder is not None else contextlib.nullcontext():
+        result = identify_file(settings, _progress())
+        if as_json:
+            echo_json(result.summary)
+            return
+        for line in lead_lines(result.summary):  # what the data cannot decide, first
+            click.echo(line)
+        if result.comparison is not None:
+            click.echo("\n".join(_comparison_lines(result)))
+        if result.selection is not None:
+            click.echo(_selection_line(result))
+        click.echo(format_model_summary(result.summary, lead=False))
+        if settings.save:
+            click.echo(f"model saved to {settings.save}")
+        if folder is not None:
+            click.echo(f"wrote {_write_report(settings, result, folder)}")
 
 
 def _progress() -> Callable[[str], None] | None:
@@ -229,8 +234,8 @@ def _progress() -> Callable[[str], None] | None:
     return say
 
 
-def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: str) -> Any:
-    """The HTML report of a fit (:func:`clpc.report.write_identify_report`)."""
+def _write_report(settings: IdentifySettings, result: IdentifyResult, out: OutputFolder) -> Any:
+    """The HTML report of a fit (:func:`clpc.report.write_identify_report`), committed."""
     record = settings.record
     shown = {
         "file": record.file,
@@ -242,7 +247,7 @@ def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: st
         "criterion": settings.criterion if not settings.compares else None,
     }
     files = write_identify_report(
-        folder,
+        out.staging,
         result.model,
         record.load(),
         title=f"identify report ({estimator_name(result.summary)} model): {Path(record.file).name}",
@@ -250,4 +255,5 @@ def _write_report(settings: IdentifySettings, result: IdentifyResult, folder: st
         selection=result.summary.get("order_selection"),
         comparison=result.comparison,
     )
-    return files[-1]
+    out.commit()  # one run's files, all complete, or the previous run's untouched
+    return out.final(files[-1])

@@ -23,6 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.atomic import atomic_file
+
 __all__ = [
     "COLORS",
     "MAX_POINTS",
@@ -190,7 +192,8 @@ def save_figure(fig: Any, path: str | PathLike[str] | None) -> None:
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     # zlib level 1, not Pillow's 6: a long trace's figure encodes 0.07 s faster, 16 % larger
-    fig.savefig(out, dpi=110, format="png", pil_kwargs={"compress_level": 1})
+    with atomic_file(out, binary=True) as fh:  # no half-written PNG, even when killed
+        fig.savefig(fh, dpi=110, format="png", pil_kwargs={"compress_level": 1})
 
 
 def envelope(

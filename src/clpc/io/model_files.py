@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 from clpc._schema import bounded_json
+from clpc.core.atomic import write_file
 from clpc.io.errors import DataFileNotFoundError
 from clpc.io.model_schema import (
     FORMAT,
@@ -73,6 +73,8 @@ def save_model(model: LinearModel, path: str | os.PathLike[str]) -> None:
     ------
     ModelFileError
         The model has non-finite parameters.
+    clpc.core.atomic.OutputError
+        ``path`` is a symbolic link, or writing failed (``path`` is left as it was).
     """
     p = Path(os.fspath(path))
     if p.is_dir():
@@ -86,22 +88,7 @@ def save_model(model: LinearModel, path: str | os.PathLike[str]) -> None:
             f"cannot save the model to '{p}': the directory '{p.parent}' does not exist; "
             "create it first."
         )
-    if p.exists():
-        mode = p.stat().st_mode & 0o777
-    else:  # what open() would give: 0o666 minus the umask
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-        os.chmod(tmp, mode)
-        os.replace(tmp, p)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    write_file(p, text)  # a temporary file renamed over p; the umask is only read
 
 
 def load_model(path: str | os.PathLike[str]) -> LinearModel:

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from clpc.core.atomic import atomic_path
 from clpc.data import DataError
 from clpc.io.formats import file_kind
 from clpc.io.mat_files import write_mat
@@ -56,15 +57,16 @@ def write_table(
     listed, arr = named_columns(
         names, array, ("write_table needs a 1-D or 2-D array", "write_table needs")
     )
-    if kind == "text":
-        if any("\n" in n or "\r" in n for n in listed):
-            raise DataError(f"column names of a text file cannot contain line breaks: {listed}.")
-        write_text(p, listed, arr, delimiter)
-    elif kind == "parquet":
-        write_parquet(p, listed, arr)
-    elif kind == "npy":
-        write_npy(p, arr)
-    elif kind == "mat":
-        write_mat(p, listed, arr)
-    else:
-        write_npz(p, listed, arr)
+    if kind == "text" and any("\n" in n or "\r" in n for n in listed):
+        raise DataError(f"column names of a text file cannot contain line breaks: {listed}.")
+    with atomic_path(p) as tmp:  # written whole or not at all (clpc.core.atomic)
+        if kind == "text":
+            write_text(tmp, listed, arr, delimiter)
+        elif kind == "parquet":
+            write_parquet(tmp, listed, arr)
+        elif kind == "npy":
+            write_npy(tmp, arr)
+        elif kind == "mat":
+            write_mat(tmp, listed, arr)
+        else:
+            write_npz(tmp, listed, arr)

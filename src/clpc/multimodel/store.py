@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.atomic import write_file
 from clpc.core.jsonable import jsonable
 from clpc.model import LinearModel
 from clpc.multimodel.fitting import Fitted
@@ -102,7 +103,7 @@ def from_dict(cls: Any, data: dict[str, Any]) -> Any:
 
 def save(mm: Any, path: Any) -> None:
     """Write the multi-model as JSON to ``path``."""
-    Path(path).write_text(json.dumps(to_dict(mm), indent=1), encoding="utf-8")
+    write_file(path, json.dumps(to_dict(mm), indent=1))  # atomic: see clpc.core.atomic
 
 
 def load(cls: Any, path: Any) -> Any:

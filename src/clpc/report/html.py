@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from clpc.core.atomic import write_file
+
 __all__ = ["Section", "table_html", "warnings_html", "write_html_report"]
 
 #: an image: its file, or its file and a caption
@@ -222,5 +224,5 @@ def write_html_report(
         sec = sec if isinstance(sec, Section) else Section(**sec)
         parts.append(_section_html(sec, out.parent, embed_images))
     parts.append("</main></body></html>")
-    out.write_text("\n".join(parts), encoding="utf-8")
+    write_file(out, "\n".join(parts))  # atomic: see clpc.core.atomic
     return out

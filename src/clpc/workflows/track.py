@@ -17,6 +17,7 @@ from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
 from clpc.core.figure import MAX_POINTS
+from clpc.core.output_folder import OutputFolder
 from clpc.data import DataError, IOData
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
@@ -363,6 +364,10 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
 
     Writes ``OUT/trace.FMT`` (one row per cluster update), the figures and ``report.html``
     (see :func:`clpc.report.write_track_report`), and the steady-state model if asked.
+    ``OUT`` is written as one transaction (:class:`clpc.core.output_folder.OutputFolder`):
+    locked against a second run, the files staged in a hidden folder and moved in when all
+    are complete, the previous run's files replaced; an error or a kill leaves ``OUT`` as
+    it was.
     The figures use a thinned copy of the trace when there are many updates; every count,
     the convergence point and the steady-state model come from all updates (kept in memory
     with only the arrays they need, see :class:`_SummaryTrace`).
@@ -386,6 +391,9 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         The record has both ``dt`` and ``time_col``.
     clpc.DataError
         Unreadable record; a time column that is not uniform; too few samples.
+    clpc.core.atomic.OutputError
+        ``OUT`` is locked by another run, a target is a symbolic link, or a file could not
+        be written (the message names it).
     """
     settings.record.check_sampling()
     if settings.record.resample:
@@ -393,15 +401,20 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
             "track reads the record in chunks and cannot resample it; resample it first "
             "(clpc.IOData.resample, or load_iodata(..., resample=True) and write_table)."
         )
-    out = Path(settings.out_dir)
-    trace_file = out / f"trace.{settings.fmt}"
-    run = _appraise(settings, trace_file, progress)
-    return _finish(settings, run, trace_file)
+    with OutputFolder(settings.out_dir, "--out") as folder:
+        trace_file = folder.staging / f"trace.{settings.fmt}"
+        run = _appraise(settings, trace_file, progress)
+        result = _finish(settings, run, trace_file, folder.staging)
+        folder.commit()
+        files = [folder.final(f) for f in result.files]
+    if settings.save and result.model is not None:
+        save_model(result.model, settings.save)
+        files.append(Path(settings.save))
+    return dataclasses.replace(result, files=files)
 
 
-def _finish(settings: TrackSettings, run: _Run, trace_file: Path) -> TrackResult:
-    """The report and the saved model of an appraised record."""
-    out = Path(settings.out_dir)
+def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> TrackResult:
+    """The report of an appraised record, written into ``out``."""
     _check_long_enough(run, settings, trace_file)
     trace = run.kept.trace()
     whole = run.whole.trace()
@@ -425,8 +438,4 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path) -> TrackResult
         recent=run.whole.last,
         **_report_data(run, trace),
     )
-    files = [trace_file, *report]
-    if settings.save and model is not None:
-        save_model(model, settings.save)
-        files.append(Path(settings.save))
-    return TrackResult(summary, model, source, files)
+    return TrackResult(summary, model, source, [trace_file, *report])
