@@ -86,7 +86,12 @@ def public_callables() -> Iterator[tuple[str, Callable[..., Any], str]]:
             if inspect.isclass(obj):
                 # the class docstring documents the constructor (numpydoc's convention)
                 yield f"{package}.{name}", obj, obj.__doc__ or ""
-                for attr, member in vars(obj).items():
+                # methods a clpc base class gives it (e.g. ``MultiModel``'s file methods) too
+                members: dict[str, Any] = {}
+                for base in reversed(obj.__mro__):
+                    if base.__module__.split(".")[0] == "clpc":
+                        members.update(vars(base))
+                for attr, member in members.items():
                     fn = (
                         member.__func__
                         if isinstance(member, (classmethod, staticmethod))

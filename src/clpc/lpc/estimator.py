@@ -15,148 +15,19 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.linalg import lapack
 
-from clpc.core import rules
 from clpc.data import DataError, IOData
 from clpc.data.samples import check_spread
+from clpc.lpc.fit_info import fit_info
+from clpc.lpc.jackknife import jackknife_entries
 from clpc.lpc.problem import FitProblem
 from clpc.lpc.reduction import reduce_model
-from clpc.lpc.regressors import MimoMode, Structure, regressors
-from clpc.lpc.solve import RobustRule, SolveResult, noise_covariance, solve_scatter
-from clpc.lpc.uncertainty import covariance_entries, jackknife_blocks, lpc_jackknife, monic_map
-from clpc.model import LinearModel, ModelError
-from clpc.model.structure import input_blocks
+from clpc.lpc.regressors import MimoMode, Structure
+from clpc.lpc.scatter import lpc_solve, r_factor, structure_blocks
+from clpc.lpc.solve import RobustRule, SolveResult, noise_covariance
+from clpc.model import LinearModel
 
 __all__ = ["LPC", "fit_info", "lpc_solve", "r_factor", "structure_blocks"]
-
-
-def structure_blocks(structure: Structure, n_input_blocks: int) -> list[slice]:
-    """Column slices of one lag vector: the output block, then one block per input."""
-    na1, nb1 = structure.na + 1, structure.nb + 1
-    return [slice(0, na1)] + [
-        slice(na1 + i * nb1, na1 + (i + 1) * nb1) for i in range(n_input_blocks)
-    ]
-
-
-def lpc_solve(
-    matrices: np.ndarray,
-    *,
-    n_output_cols: int,
-    blocks: list[slice],
-    method: str = "robust",
-    noise_cov: np.ndarray | None = None,
-    rule: RobustRule | None = None,
-    scaling: str = "none",
-) -> SolveResult:
-    """LPC of one or more lag matrices (rows are lag vectors ``z_n``).
-
-    Parameters
-    ----------
-    matrices : ndarray, shape (k, n_rows, p)
-        Lag matrices (paper eq. 36), e.g. from :func:`clpc.lpc.regressors.regressors`.
-    n_output_cols, blocks, method, noise_cov, rule, scaling
-        See :func:`clpc.lpc.solve.solve_scatter`.
-
-    Returns
-    -------
-    SolveResult
-        The centering (eqs. 24-25) is two-pass and the decomposition is the SVD of the
-        centered data (through its QR factor, :func:`r_factor`), so large offsets (e.g.
-        positions around 1e4 rad) lose no digits.
-    """
-    mats = np.asarray(matrices, dtype=np.float64)
-    k, n, p = mats.shape
-    mean = mats.mean(axis=1)
-    scatter = np.empty((k, p, p))
-    factors = np.empty((k, p, p)) if n >= p else None  # the SVD needs n >= p
-    for i in range(k):
-        centered = np.subtract(mats[i], mean[i], order="F")  # eq. 25, two-pass (a copy)
-        scatter[i] = centered.T @ centered  # eq. 27
-        if factors is not None:
-            factors[i] = r_factor(centered)
-    return solve_scatter(
-        scatter,
-        mean,
-        np.full(k, n),
-        n_output_cols=n_output_cols,
-        blocks=blocks,
-        method=method,
-        noise_cov=noise_cov,
-        rule=rule,
-        data=factors,
-        scaling=scaling,
-    )
-
-
-def r_factor(centered: np.ndarray) -> np.ndarray:
-    """``R`` of ``M = Q R`` (Householder QR): ``M``'s singular values and right vectors.
-
-    Parameters
-    ----------
-    centered : ndarray, shape (n, p), n >= p, Fortran order
-        Centered lag matrix; overwritten (LAPACK ``dgeqrf`` in place).
-
-    Returns
-    -------
-    ndarray, shape (p, p)
-        Upper triangular; ``R^T R = M^T M`` and ``svd(R)`` gives ``svd(M)``'s ``s`` and
-        ``V`` (backward stable like the SVD of ``M``, in O(n p^2) time with no n x p
-        ``U``: 6x less time than ``numpy.linalg.svd(M, full_matrices=False)`` at 1e6 rows).
-    """
-    packed, _, _, info = lapack.dgeqrf(centered, overwrite_a=True)
-    if info != 0:  # pragma: no cover - LAPACK argument errors only
-        raise np.linalg.LinAlgError(f"QR of the lag matrix failed (LAPACK info {info}).")
-    p = centered.shape[1]
-    return np.triu(packed[:p])
-
-
-def fit_info(res: SolveResult, n_rows: np.ndarray, rule: RobustRule) -> dict[str, Any]:
-    """Statistics of a solve as plain arrays (one entry per equation).
-
-    Keys: ``eigenvalues``, ``lambda_min``, ``lambda_max``, ``D`` (``lambda_max -
-    lambda_min``, the paper's degree of linearity), ``eig_ratio`` (``lambda_min /
-    lambda_max``, scale-free), ``separation``, ``a0_weight`` (the unit-free ``y(n)``
-    weight of the solution), ``c``, ``noise_variance``,
-    ``log_likelihood``, ``J`` (eq. 22), ``n_rows``, ``n_null``, ``n_input_relations``,
-    ``degenerate``, ``determined``. Each number comes from :mod:`clpc.core.rules`, the
-    functions the CLPC kernel compiles.
-    """
-    vals = res.eigenvalues
-    n = np.asarray(n_rows, dtype=np.float64) * np.ones(vals.shape[0])
-    lam_min, lam_max = vals[:, 0].copy(), vals[:, -1].copy()
-    ll_var = [
-        rules.likelihood_variance(float(v), float(hi), float(m))
-        for v, hi, m in zip(res.noise_variance, lam_max, n, strict=True)
-    ]
-    determined = [
-        rules.is_determined(int(a), int(b), float(c), bool(d), rule.separation)
-        for a, b, c, d in zip(
-            res.n_null, res.n_input_relations, res.separation, res.degenerate, strict=True
-        )
-    ]
-    return {
-        "eigenvalues": vals,
-        "lambda_min": lam_min,
-        "lambda_max": lam_max,
-        "D": lam_max - lam_min,
-        "eig_ratio": np.array(
-            [rules.eig_ratio(lo, hi) for lo, hi in zip(lam_min, lam_max, strict=True)]
-        ),
-        "separation": res.separation,
-        "a0_weight": res.a0_weight,
-        "c": res.c,
-        "noise_variance": res.noise_variance,
-        "log_likelihood": np.array(
-            [rules.log_likelihood(v, m) for v, m in zip(ll_var, n, strict=True)]
-        ),
-        "J": np.array([rules.index_j(v, m) for v, m in zip(ll_var, n, strict=True)]),
-        "n_rows": np.asarray(n_rows),
-        "n_null": res.n_null,
-        "n_input_relations": res.n_input_relations,
-        "degenerate": res.degenerate,
-        "determined": np.array(determined, dtype=bool),
-    }
 
 
 @dataclass
@@ -284,46 +155,15 @@ class LPC:
         )
         covariance = None
         if self.uncertainty:
-            covariance = lambda fitted: self._covariance_entries(fitted, data, rule)  # noqa: E731
+            settings = {
+                "method": self.method,
+                "scaling": self.scaling,
+                "noise_cov": self.noise_cov,
+                "noise_ratio": self.noise_ratio,
+            }
+            covariance = lambda fitted: jackknife_entries(fitted, data, rule, **settings)  # noqa: E731
         model = problem.model(self, res.theta, res.c, info, covariance)
         return reduce_model(model, data) if self.cancel else model
-
-    def _covariance_entries(
-        self, model: LinearModel, data: IOData, rule: RobustRule
-    ) -> dict[str, Any]:
-        """The block-jackknife covariance of this solve at ``model``'s structure (entries)."""
-        s, mode = model.structure, model.mode
-        n_blocks_in = input_blocks(mode, data.n_inputs)
-        mats = regressors(data, s, mode)  # type: ignore[arg-type]
-        groups = jackknife_blocks(mats.shape[1], mats.shape[2])
-        if not groups:
-            return {"covariance_note": f"{mats.shape[1]} lag vectors are too few to split"}
-        try:
-            noise_cov = noise_covariance(self.noise_cov, self.noise_ratio, s, n_blocks_in)
-        except ValueError:
-            return {"covariance_note": "the noise covariance does not fit the reduced order"}
-
-        def solve(scatter: np.ndarray, mean: np.ndarray, rows: np.ndarray) -> np.ndarray:
-            return solve_scatter(
-                scatter, mean, rows, n_output_cols=s.na + 1,
-                blocks=structure_blocks(s, n_blocks_in), method=self.method,
-                noise_cov=noise_cov, rule=rule, scaling=self.scaling,
-            ).theta  # fmt: skip
-
-        def to_monic(theta: np.ndarray, j: int) -> np.ndarray:
-            a0 = theta[:, :1]
-            if np.any(np.abs(a0) <= 1e-9 * np.linalg.norm(theta, axis=1, keepdims=True)):
-                raise ModelError("a jackknife replicate has a0 about 0 (no monic form)")
-            return (theta[:, 1:] / a0) @ monic_map(s, model.n_inputs, mode, j).T
-
-        try:
-            cov = lpc_jackknife(mats, solve, to_monic, groups)
-        except (ModelError, ValueError) as exc:  # no monic replicate; a noise_cov of p entries
-            return {"covariance_note": f"the jackknife could not run: {exc}"}
-        how = f"block jackknife over {groups} segments"
-        if model.info.get("cancelled"):
-            how += " (LPC solve at the reduced order)"
-        return covariance_entries(cov, groups - 1, how)
 
 
 def _raise_if_degenerate(res: SolveResult, data: IOData) -> None:

@@ -144,7 +144,7 @@ def solve_scatter(
         Thresholds of the robust solution.
     data : ndarray, shape (k, n, p), optional
         Centered data matrices, or their ``R`` factors (shape (k, p, p),
-        :func:`clpc.lpc.estimator.r_factor`: the same singular values and right vectors);
+        :func:`clpc.lpc.scatter.r_factor`: the same singular values and right vectors);
         when given (one-shot fits) the decomposition is the SVD of the data, which is more
         accurate than the eigen-decomposition of the scatter.
     scaling : {"none", "std"}

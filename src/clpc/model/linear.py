@@ -22,26 +22,25 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from scipy import signal
-
 from clpc.core.filters import frequency_response
 from clpc.core.polynomials import monic, pole_class
-from clpc.model import display, simulation
-from clpc.model import uncertainty as _unc
+from clpc.model import display
 from clpc.model.errors import ModelError
 from clpc.model.evidence import FitInfo, FitRecord
+from clpc.model.export import Exports
 from clpc.model.structure import Structure
+from clpc.model.time_domain import TimeDomain
+from clpc.model.uncertainty_methods import UncertaintyMethods
 
 __all__ = ["LinearModel", "ModelError"]
 
 
 @dataclass(frozen=True, eq=False)
-class LinearModel:
+class LinearModel(TimeDomain, UncertaintyMethods, Exports):
     """A (multi-)output linear model ``A_j(q) y_j = sum_i Bn_ji(q) u_i + k_j + e_j``.
 
     Parameters
@@ -298,251 +297,6 @@ class LinearModel:
         from clpc.model.verdict import fit_verdict
 
         return fit_verdict(self, output)
-
-    # ------------------------------------------- uncertainty (clpc.model.uncertainty)
-    @property
-    def covariance(self) -> np.ndarray:
-        """Covariance of ``np.r_[den[1:], num]`` per output, shape (n_outputs, q, q)."""
-        return _unc.covariance(self)
-
-    def confidence_interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
-        """``(lo, hi)`` ordered like ``np.r_[den[1:], num]`` (rows per output if several).
-
-        Parameters
-        ----------
-        level : float
-            Two-sided confidence level in (0, 1) (default 0.95; Student's ``t`` quantile).
-
-        Returns
-        -------
-        lo, hi : ndarray, shape (q,) for a SISO model, else (n_outputs, q)
-            See :func:`clpc.model.uncertainty.confidence_interval`.
-        """
-        return _unc.confidence_interval(self, level)
-
-    def pole_std(self, output: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """Poles and the std of their real and imaginary parts, shape (na, 2).
-
-        Parameters
-        ----------
-        output : int
-            Output index (default 0).
-
-        Returns
-        -------
-        poles : ndarray of complex, shape (na,)
-        std : ndarray, shape (na, 2)
-            Standard deviation of ``(Re p, Im p)`` per pole (delta method).
-        """
-        return _unc.pole_std(self, output)
-
-    def dc_gain_std(self) -> np.ndarray:
-        """Standard deviation of :meth:`dc_gain`, shape (n_outputs, n_inputs)."""
-        return _unc.dc_gain_std(self)
-
-    def frequency_response_std(
-        self, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(freqs_hz, response, std of |G|, std of arg G [rad])`` (delta method).
-
-        Parameters
-        ----------
-        freqs : int or ndarray
-            Number of frequencies up to Nyquist, or frequencies [Hz] (default 512).
-        output, input : int
-            Channel pair (default 0, 0).
-
-        Returns
-        -------
-        freqs_hz : ndarray, shape (n_freqs,)
-            Frequencies [Hz].
-        response : ndarray of complex, shape (n_freqs,)
-        magnitude_std : ndarray, shape (n_freqs,)
-            Standard deviation of ``|G|`` (same units as ``|G|``).
-        phase_std : ndarray, shape (n_freqs,)
-            Standard deviation of ``arg G`` [rad].
-        """
-        return _unc.frequency_response_std(self, freqs, output, input)
-
-    def summary(self) -> str:
-        """Coefficients with +- one standard deviation, poles and DC gains, as text."""
-        return _unc.summary(self)
-
-    # ----------------------------------------------------------------- time domain
-    def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
-        """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
-        return simulation.forced(self, u, u_init)
-
-    def simulate(
-        self,
-        u: Any,
-        *,
-        y_init: Any | None = None,
-        u_init: Any | None = None,
-        include_offset: bool = True,
-    ) -> np.ndarray:
-        """Free-run simulation from the input alone.
-
-        Parameters
-        ----------
-        u : array_like, shape (T,) or (T, n_inputs), or IOData
-            Input samples, or a record (its inputs; a record of several experiments is
-            simulated one experiment at a time, each from zero initial conditions, and
-            stacked).
-        y_init : array_like, shape (na,) or (na, n_outputs), optional
-            The ``na`` outputs just before ``u[0]``, oldest first. Default: zeros.
-        u_init : array_like, shape (nk+nb,) or (nk+nb, n_inputs), optional
-            The inputs just before ``u[0]``, oldest first. Default: zeros.
-        include_offset : bool
-            Add the identified constant ``c/a0`` (default). ``False`` simulates the
-            deviation model ``lfilter(num, den, u)`` exactly.
-
-        Returns
-        -------
-        ndarray, shape (T,) for a SISO model given 1-D ``u``, else (T, n_outputs)
-            (a record's ``y`` shape).
-        """
-        return simulation.simulate(
-            self, u, y_init=y_init, u_init=u_init, include_offset=include_offset
-        )
-
-    def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
-        """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data.
-
-        Each prediction uses measured outputs up to ``n - k`` and the model for the rest
-        (for ``k = 1`` the one-step-ahead predictor of the equation). An output-error
-        model (``info["noise_model"] == "output-error"``, :class:`clpc.OE`; per output
-        for a list) assumes white noise on the output: its ``k``-step predictor is the free
-        run from the input for every ``k``, started from the measured samples before
-        ``max_lag`` (:func:`clpc.model.simulation.noise_models`). The first
-        ``max_lag`` samples have no complete past and are returned as measured; the next
-        ``k - 1`` can only use the measured start of the record, so they are predictions
-        over fewer than ``k`` steps (:func:`clpc.kstep_fit` skips them).
-
-        Parameters
-        ----------
-        u : array_like, shape (T,) or (T, n_inputs), or IOData
-            Measured inputs, or a record (its inputs and outputs; then leave ``y`` out and
-            give ``k`` by keyword: ``predict(data, k=10)``). A record of several experiments
-            is predicted one experiment at a time, and stacked.
-        y : array_like, shape (T,) or (T, n_outputs)
-            Measured outputs (required with array inputs).
-        k : int
-            Prediction horizon in samples (>= 1).
-
-        Returns
-        -------
-        ndarray, same shape as ``y`` (a record's ``y`` shape)
-        """
-        return simulation.predict(self, u, y, k)
-
-    def infer_input(
-        self, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
-    ) -> np.ndarray:
-        """The input that explains a measured output (SISO): ``u = (den y - intercept) / num``.
-
-        This is the paper's estimated torque command (Figs. 13-14).
-
-        Parameters
-        ----------
-        y : array_like, shape (T,), or IOData
-            Measured output, or a record of one experiment (its output).
-        y_init : array_like, shape (na,), optional
-            Outputs before ``y[0]`` (oldest first). Default: ``y[0]`` repeated (rest).
-        allow_unstable : bool
-            Compute even when ``num(z)`` has zeros outside the unit circle (the inverse
-            then diverges); default raises :class:`ModelError`.
-
-        Returns
-        -------
-        ndarray, shape (T - nk,)
-            ``u_hat[m]`` estimates ``u[m]`` for ``m = 0 .. T-nk-1`` (zero initial state of
-            the inverse filter).
-        """
-        return simulation.infer_input(self, y, y_init=y_init, allow_unstable=allow_unstable)
-
-    def _padded(self, output: int, input: int) -> tuple[np.ndarray, np.ndarray]:
-        """Numerator and denominator in descending powers of ``z`` (equal length)."""
-        num = self.numerators[output, input]
-        den = self.denominators[output]
-        n = max(num.size, den.size)
-        return np.pad(num, (0, n - num.size)), np.pad(den, (0, n - den.size))
-
-    def to_scipy(self, output: int = 0, input: int = 0) -> signal.dlti:
-        """Export one channel pair as :class:`scipy.signal.dlti` (``dt`` = sample time).
-
-        Parameters
-        ----------
-        output, input : int
-            Channel pair (default 0, 0).
-
-        Returns
-        -------
-        scipy.signal.dlti
-            ``num / den`` in descending powers of ``z``; the constant ``intercept`` is not
-            exported.
-        """
-        num, den = self._padded(output, input)
-        # leading zeros (input delay nk) are zero high-power coefficients: dropping them keeps
-        # G(z) and spares scipy's "badly conditioned numerator" warning
-        num = np.trim_zeros(num, "f") if np.any(num) else num[-1:]
-        from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
-
-        return signal.dlti(num, den, dt=self.dt)
-
-    def to_control(self, *, include_offset: bool = False) -> Any:
-        """Export as a python-control ``StateSpace`` system with the channel names.
-
-        Each output equation is realised in observer canonical form (its inputs share the
-        denominator ``A_j``; ``n = max(na, nk + nb)`` states), the outputs stacked block by
-        block. A state-space system simulates without slycot (a MIMO transfer function
-        does not); ``control.ss2tf`` gives the transfer function of a SISO export.
-
-        Parameters
-        ----------
-        include_offset : bool
-            ``False`` (default): the system from the inputs alone, ``G = num/den`` per
-            channel (the deviation model, like ``simulate(..., include_offset=False)``), so
-            ``control.dcgain`` and ``control.step_response`` are ``n_outputs x n_inputs``
-            and equal :meth:`dc_gain` and the model's step. ``True`` adds an input named
-            ``"offset"`` (last) through which the constant ``intercept_j`` enters output
-            ``j`` as ``intercept_j / A_j(z)``: driven with ones, ``control.forced_response``
-            equals :meth:`simulate` (zero initial conditions, offset included).
-
-        Returns
-        -------
-        control.StateSpace
-            Inputs named after :attr:`input_names` (and ``"offset"``), outputs after
-            :attr:`output_names`, ``dt`` the sample time [s]. Needs the optional
-            dependency ``control`` (``pip install ".[control]"`` from the source tree).
-        """
-        try:
-            import control
-        except ImportError:  # pragma: no cover - depends on the environment
-            raise ImportError(
-                "to_control() needs python-control: pip install control (or, in the clpc "
-                "source tree, pip install '.[control]')"
-            ) from None
-        blocks = []
-        for j in range(self.n_outputs):
-            pairs = [self._padded(j, i) for i in range(self.n_inputs)]
-            if include_offset:
-                den = pairs[0][1]
-                pairs.append((np.r_[self.intercept[j], np.zeros(den.size - 1)], den))
-            blocks.append(simulation.observer_form([p[0] for p in pairs], pairs[0][1]))
-        n_in = self.n_inputs + int(include_offset)
-        sizes = [blk[0].shape[0] for blk in blocks]
-        a = np.zeros((sum(sizes), sum(sizes)))
-        b = np.zeros((sum(sizes), n_in))
-        c = np.zeros((self.n_outputs, sum(sizes)))
-        d = np.zeros((self.n_outputs, n_in))
-        at = 0
-        for j, (aj, bj, cj, dj) in enumerate(blocks):
-            sl = slice(at, at + sizes[j])
-            a[sl, sl], b[sl], c[j, sl], d[j] = aj, bj, cj, dj
-            at += sizes[j]
-        inputs = [*self.input_names, *(["offset"] if include_offset else [])]
-        return control.ss(a, b, c, d, self.dt, inputs=inputs, outputs=list(self.output_names))
 
     def __repr__(self) -> str:
         return display.model_repr(self)

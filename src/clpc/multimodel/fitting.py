@@ -34,7 +34,7 @@ from clpc.multimodel.local import fit_local
 from clpc.multimodel.schedule import Schedule
 from clpc.multimodel.validity import kmeans_1d, validity, widths_for
 
-__all__ = ["Fitted", "Windows", "fit_all", "monic_arrays"]
+__all__ = ["Fitted", "Windows", "fit_all", "monic_arrays", "trace_windows"]
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,19 @@ def own_windows(start: int, n_samples: int, window: int, cluster: int) -> Window
     """CLPC's windows (``window`` lag vectors, one update per ``cluster``) of a record."""
     m = np.arange(cluster, n_samples - start + 1, cluster)
     return Windows(start + m - 1, np.minimum(m, window), f"windows of {window} every {cluster}")
+
+
+def trace_windows(trace: Any) -> Windows:
+    """The trusted windows of a CLPC trace (:class:`clpc.Trace`), which place the centres."""
+    ok = np.asarray(trace.arrays["trusted"]).all(axis=1) & ~np.asarray(trace.not_enough_data)
+    if not ok.any():
+        raise ValueError("the trace has no trusted window: nothing places the centres.")
+    windows = Windows(
+        np.asarray(trace.index)[ok],
+        np.asarray(trace.rows)[ok],
+        "the CLPC trace's trusted windows",
+    )
+    return windows
 
 
 def monic_arrays(models: list[LinearModel]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

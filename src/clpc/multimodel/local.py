@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from clpc.lpc.estimator import fit_info, structure_blocks
+from clpc.lpc.fit_info import fit_info
 from clpc.lpc.heldout import stability
+from clpc.lpc.scatter import structure_blocks
 from clpc.lpc.solve import RobustRule, solve_scatter
 from clpc.model import LinearModel
 from clpc.model.structure import Structure
@@ -40,7 +41,7 @@ def weighted_lpc(
     """Validity-weighted LPC of lag vectors ``rows`` (shape (n, p)) with weights ``w`` (n,).
 
     Returns ``(theta, c, info)``: unit-norm ``theta`` (shape (p,)), ``c = Z^T theta`` and
-    the statistics of :func:`clpc.lpc.estimator.fit_info` (``n_rows = sum w``).
+    the statistics of :func:`clpc.lpc.fit_info.fit_info` (``n_rows = sum w``).
     """
     mean, centered, total = _weighted_moments(rows, w)
     scaled = centered * np.sqrt(w)[:, None]

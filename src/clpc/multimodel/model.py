@@ -24,19 +24,21 @@ import numpy as np
 
 from clpc.core.compact import html_table, summarise
 from clpc.data import as_iodata
-from clpc.data.signals import signals
 from clpc.model import LinearModel
-from clpc.model.errors import as_2d
 from clpc.model.structure import Structure
-from clpc.multimodel.fitting import Fitted, Windows, blend_run, fit_all, monic_arrays, own_windows
-from clpc.multimodel.prediction import predict_kstep
+from clpc.multimodel.files import ModelFiles
+from clpc.multimodel.fitting import Fitted, Windows, fit_all, own_windows, trace_windows
+from clpc.multimodel.free_run import free_run
+from clpc.multimodel.linearization import linearize
+from clpc.multimodel.prediction import predict_measured
 from clpc.multimodel.schedule import Schedule, parse_schedule
+from clpc.multimodel.settings import check_settings
 from clpc.multimodel.validity import validity
 
 __all__ = ["MultiModel"]
 
 
-class MultiModel:
+class MultiModel(ModelFiles):
     """A multi-model of local LPC models (single output, one or more inputs).
 
     Parameters
@@ -85,32 +87,16 @@ class MultiModel:
         method: str = "robust",
     ) -> None:
         self.structure = Structure.from_settings(order, na, nb, nk)
-        for name, value, low in (
-            ("n_models", n_models, 1),
-            ("max_models", max_models, 1),
-            ("window_size", window_size, 2),
-            ("cluster_size", cluster_size, 1),
-        ):
-            if value is None and name == "n_models":
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ValueError(f"{name} must be an int >= {low}; got {value!r}.")
-        if estimator not in ("auto", "lpc", "ls"):
-            raise ValueError(f"estimator must be 'auto', 'lpc' or 'ls'; got {estimator!r}.")
-        if not 0.05 <= float(holdout) <= 0.5:
-            raise ValueError(f"holdout must be a share in [0.05, 0.5]; got {holdout!r}.")
-        if not float(tolerance) >= 0:
-            raise ValueError(f"tolerance must be >= 0 points; got {tolerance!r}.")
-        self.settings: dict[str, Any] = {
-            "n_models": None if n_models is None else int(n_models),
-            "max_models": int(max_models),
-            "estimator": estimator,
-            "window_size": int(window_size),
-            "cluster_size": int(cluster_size),
-            "holdout": float(holdout),
-            "tolerance": float(tolerance),
-            "method": method,
-        }
+        self.settings: dict[str, Any] = check_settings(
+            n_models=n_models,
+            max_models=max_models,
+            estimator=estimator,
+            window_size=window_size,
+            cluster_size=cluster_size,
+            holdout=holdout,
+            tolerance=tolerance,
+            method=method,
+        )
         self.schedule_spec = schedule
         self._fitted: Fitted | None = None
         self.n_inputs = 1
@@ -173,14 +159,7 @@ class MultiModel:
         """
         s = trace.structure
         mm = cls(na=s.na, nb=s.nb, nk=s.nk, **settings)
-        ok = np.asarray(trace.arrays["trusted"]).all(axis=1) & ~np.asarray(trace.not_enough_data)
-        if not ok.any():
-            raise ValueError("the trace has no trusted window: nothing places the centres.")
-        windows = Windows(
-            np.asarray(trace.index)[ok],
-            np.asarray(trace.rows)[ok],
-            "the CLPC trace's trusted windows",
-        )
+        windows = trace_windows(trace)
         return mm._fit(u, y, trace.sample_time, windows)
 
     # ----------------------------------------------------------------- views
@@ -252,23 +231,7 @@ class MultiModel:
         """
         f = self._require()
         sched = self._schedule()
-        u2, _ = as_2d(signals(u, what="simulate", needs_y=False)[0], self.n_inputs, "u")
-        s = self.structure
-        pad = max(s.na, s.nk + s.nb, sched.lag, 1)
-        y_ext = np.zeros(pad + u2.shape[0])
-        u_ext = np.zeros((pad + u2.shape[0], self.n_inputs))
-        u_ext[pad:] = u2
-        if y_init is not None:
-            y0 = np.asarray(y_init, dtype=np.float64).ravel()[-pad:]
-            y_ext[pad - y0.size : pad] = y0
-        if u_init is not None:
-            u0, _ = as_2d(u_init, self.n_inputs, "u_init")
-            u0 = u0[-pad:]
-            u_ext[pad - u0.shape[0] : pad] = u0
-        arrays = monic_arrays(f.local_models)
-        with np.errstate(all="ignore"):
-            blend_run(arrays, f.centres, f.widths, sched, u_ext, y_ext, pad)
-        return y_ext[pad:]
+        return free_run(f, sched, self.structure, self.n_inputs, u, y_init, u_init)
 
     def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
         """``k``-step-ahead prediction ``y_hat(n | n-k)`` from measured data (vectorised).
@@ -294,14 +257,7 @@ class MultiModel:
             raise ValueError(f"k must be an int >= 1; got {k!r}.")
         f = self._require()
         sched = self._schedule()
-        u, y = signals(u, y, what="predict")
-        u2, _ = as_2d(u, self.n_inputs, "u")
-        y1 = np.asarray(y, dtype=np.float64).ravel()
-        if u2.shape[0] != y1.shape[0]:
-            raise ValueError(
-                f"u and y must have the same length; got {u2.shape[0]}, {y1.shape[0]}."
-            )
-        return predict_kstep(monic_arrays(f.local_models), f, sched, self.structure, u2, y1, k)
+        return predict_measured(f, sched, self.structure, self.n_inputs, u, y, k)
 
     def linearize(self, operating_point: float) -> LinearModel:
         """The frozen-validity local model at a scheduling value (a :class:`LinearModel`).
@@ -321,74 +277,7 @@ class MultiModel:
             Single output, ``dt`` the multi-model's; ``info["operating_point"]`` records it.
         """
         f = self._require()
-        den, num, icpt = monic_arrays(f.local_models)
-        phi = validity(np.float64(operating_point), f.centres, f.widths)
-        d, nm, ic = phi @ den, np.tensordot(phi, num, axes=1), float(phi @ icpt)
-        s = self.structure
-        theta = np.concatenate([d, *(-nm[c, s.nk :] for c in range(self.n_inputs))])
-        scale = float(np.linalg.norm(theta))
-        return LinearModel(
-            theta=np.atleast_2d(theta / scale),
-            structure=s,
-            n_inputs=self.n_inputs,
-            mode="siso" if self.n_inputs == 1 else "miso",
-            c=np.array([ic / scale]),
-            dt=self.dt,
-            info={"method": "multimodel-linearization", "operating_point": float(operating_point)},
-        )
-
-    # ----------------------------------------------------------------- files
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-safe description (floats exact); see :mod:`clpc.multimodel.store`."""
-        from clpc.multimodel.store import to_dict
-
-        return to_dict(self)
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> MultiModel:
-        """Rebuild a multi-model from :meth:`to_dict` output.
-
-        Parameters
-        ----------
-        data : dict
-            The description; its ``format`` and ``version`` are checked.
-
-        Returns
-        -------
-        MultiModel
-        """
-        from clpc.multimodel.store import from_dict
-
-        return from_dict(cls, data)
-
-    def save(self, path: Any) -> None:
-        """Write :meth:`to_dict` as JSON to ``path``.
-
-        Parameters
-        ----------
-        path : str or path-like
-            File to write (UTF-8; replaced if it exists).
-        """
-        from clpc.multimodel.store import save
-
-        save(self, path)
-
-    @classmethod
-    def load(cls, path: Any) -> MultiModel:
-        """Read a multi-model written by :meth:`save`.
-
-        Parameters
-        ----------
-        path : str or path-like
-            JSON file written by :meth:`save`.
-
-        Returns
-        -------
-        MultiModel
-        """
-        from clpc.multimodel.store import load
-
-        return load(cls, path)
+        return linearize(f, self.structure, self.n_inputs, self.dt, operating_point)
 
     def __repr__(self) -> str:
         s = self.structure

@@ -6,11 +6,14 @@ from typing import Any
 
 import numpy as np
 
+from clpc.data.signals import signals
+from clpc.model.errors import as_2d
 from clpc.model.structure import Structure
+from clpc.multimodel.fitting import Fitted, monic_arrays
 from clpc.multimodel.schedule import Schedule
 from clpc.multimodel.validity import validity
 
-__all__ = ["predict_kstep"]
+__all__ = ["predict_kstep", "predict_measured"]
 
 
 def predict_kstep(
@@ -51,3 +54,44 @@ def predict_kstep(
         cur[start:] = (validity(psi, f.centres, f.widths) * local).sum(axis=1)
         preds.append(cur)
     return preds[k]
+
+
+def predict_measured(
+    fitted: Fitted,
+    schedule: Schedule,
+    structure: Structure,
+    n_inputs: int,
+    u: Any,
+    y: Any,
+    k: int,
+) -> np.ndarray:
+    """:func:`predict_kstep` on measured data given as arrays or a record.
+
+    Parameters
+    ----------
+    fitted : Fitted
+        The local models, centres and widths.
+    schedule : Schedule
+        The scheduling variable.
+    structure : Structure
+        Orders and delay shared by the local models.
+    n_inputs : int
+        Number of inputs.
+    u : array_like, shape (T,) or (T, n_inputs), or IOData
+        Input samples, or a record of one experiment.
+    y : array_like, shape (T,), optional
+        Measured output (required with array inputs).
+    k : int
+        Prediction horizon in samples (>= 1, checked by the caller).
+
+    Returns
+    -------
+    ndarray, shape (T,)
+    """
+    u, y = signals(u, y, what="predict")
+    u2, _ = as_2d(u, n_inputs, "u")
+    y1 = np.asarray(y, dtype=np.float64).ravel()
+    if u2.shape[0] != y1.shape[0]:
+        raise ValueError(f"u and y must have the same length; got {u2.shape[0]}, {y1.shape[0]}.")
+    arrays = monic_arrays(fitted.local_models)
+    return predict_kstep(arrays, fitted, schedule, structure, u2, y1, k)
