@@ -24,6 +24,7 @@ from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
+from clpc.workflows.save_check import save_refusal
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
 
@@ -94,12 +95,16 @@ class TrackResult:
         Where ``model`` comes from (see :func:`clpc.report.steady_state`).
     files : list of Path
         Files written: trace, figures, report and the saved model.
+    save_refused : str or None
+        Why ``--save`` saved nothing although a model exists (one line, see
+        :func:`clpc.workflows.save_check.save_refusal`); ``None`` otherwise.
     """
 
     summary: dict[str, Any]
     model: LinearModel | None
     model_source: str
     files: list[Path]
+    save_refused: str | None = None
 
 
 def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
@@ -426,7 +431,10 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path) -> TrackResult
         **_report_data(run, trace),
     )
     files = [trace_file, *report]
+    refused = None
     if settings.save and model is not None:
-        save_model(model, settings.save)
-        files.append(Path(settings.save))
-    return TrackResult(summary, model, source, files)
+        refused = save_refusal(model, settings.save)
+        if refused is None:
+            save_model(model, settings.save)
+            files.append(Path(settings.save))
+    return TrackResult(summary, model, source, files, refused)
