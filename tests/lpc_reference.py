@@ -112,6 +112,10 @@ def solve_scatter(
     wt = s_col * theta
     wt_norm = np.linalg.norm(wt, axis=1)
     a0_weight = np.abs(wt[:, 0]) / np.where(wt_norm > 0, wt_norm, 1.0)
+    # a solution that hardly involves y(n) is itself an input relation
+    n_input = np.where(
+        ~degenerate & ~(a0_weight >= rule.min_a0_weight), np.maximum(n_input, 1), n_input
+    )
     theta = _normalise(theta)
     theta[degenerate] = 0.0
     c = np.einsum("kp,kp->k", mean, theta)
@@ -320,7 +324,9 @@ def reference_clpc(u: np.ndarray, y: np.ndarray, appraiser: Any) -> dict[str, np
     )
     need = a.trust_rows or min(max(10 * p, int(np.ceil(0.5 * a.window_size))), a.window_size)
     trusted = (arr["rows"][:, None] >= need) & np.array(excited) & determined
-    accepted = ~not_enough[:, None] & ~arr["degenerate"] & (arr["a0_weight"] >= 1e-3)
+    accepted = (
+        ~not_enough[:, None] & ~arr["degenerate"] & (arr["a0_weight"] >= a.rule.min_a0_weight)
+    )
     if a.guard:
         accepted &= trusted
     idx = np.where(accepted, np.arange(n_updates)[:, None], -1)

@@ -268,3 +268,59 @@ def test_step_rejects_non_finite_scalars_with_the_sample_index():
     with pytest.raises(DataError, match="y channel 0 is not finite at sample 5"):
         a.step(1.0, float("nan"))
     assert a.n_samples == 5  # the bad sample was not taken
+
+
+# ---------------------------------------------------------------- the input-relation trap
+def _input_trap_record() -> tuple[np.ndarray, np.ndarray]:
+    """A chirp input (smooth: ``u(n) - 2 u(n-1) + u(n-2) ~ 0`` over many windows) and an
+    output 100 times the input's size: the paper's smallest eigenvector is then an input
+    relation whose unit-free ``y(n)`` weight (0.07-0.09) passed the former 1e-3 rule."""
+    rng = np.random.default_rng(2)
+    t = np.arange(4000)
+    u0 = np.sin(2 * np.pi * (t / 4000) ** 2 * 50)
+    den = np.real(np.poly(0.97 * np.exp(1j * np.array([0.05, -0.05]))))
+    u = u0 + 1e-4 * rng.standard_normal(t.size)
+    y = 100 * clpc.simulate_arx(den, np.array([0.0, 0.01, 0.005]), u0)
+    return u, y + 1e-2 * rng.standard_normal(t.size)
+
+
+def test_a_solution_that_is_an_input_relation_is_never_accepted():
+    """Issue 28 item 4: the guard accepted windows whose solution hardly involves y(n)."""
+    u, y = _input_trap_record()
+    rule = clpc.RobustRule()
+    for guard in (True, False):
+        tr = CLPC(method="paper", guard=guard).run(u, y)
+        # the windows the former rule accepted: one separated, computable, excited solution
+        trap = (
+            (tr.a0_weight >= 1e-3)
+            & (tr.a0_weight < rule.min_a0_weight)
+            & ~tr.degenerate
+            & ~tr.not_enough_data
+        )
+        assert trap.sum() >= 3
+        assert not tr.accepted[trap].any()
+        assert (tr.n_input_relations[trap] >= 1).all()
+        assert not tr.determined[trap].any()
+        # the other windows still decide as before: a plant relation is accepted
+        assert tr.accepted[~trap].any()
+
+
+def test_batch_lpc_flags_an_input_relation_solution_like_the_kernel():
+    u, y = _input_trap_record()
+    tr = CLPC(method="paper").run(u, y)
+    j = int(np.flatnonzero((tr.a0_weight < 0.1) & ~tr.degenerate & ~tr.not_enough_data)[0])
+    end = int(tr.index[j]) + 1
+    start = end - int(tr.rows[j]) - 2  # the window's rows and the lags before them
+    model = clpc.LPC(method="paper").fit(clpc.IOData(u[start:end], y[start:end]))
+    info = model.info
+    assert float(np.atleast_1d(info["a0_weight"])[0]) < 0.1
+    assert int(np.atleast_1d(info["n_input_relations"])[0]) >= 1
+    assert not bool(np.atleast_1d(info["determined"])[0])
+    verdict = model.verdict()
+    assert not verdict.determined
+    assert any("not persistently exciting" in n for n in verdict.messages)
+
+
+def test_robust_rule_refuses_a_zero_a0_threshold():
+    with pytest.raises(ValueError, match=r"min_a0_weight must be a number in \(0, 1\]"):
+        clpc.RobustRule(min_a0_weight=0.0)

@@ -120,6 +120,7 @@ class FsmSettings(NamedTuple):
     guard: bool  #: accept only trusted windows
     trust_rows: int  #: rows a trusted window needs
     separation_tol: float
+    min_a0_weight: float  #: below it a solution is an input relation, never accepted
     na: int
     nb: int
     nk: int
@@ -447,7 +448,8 @@ def fsm_output(solved: Solved, fs: FsmSettings, state: FsmState, out: FsmOutput)
             out.determined[w, e] = det
             trusted = is_trusted(n_rows, fs.trust_rows, solved.excited[w, e], det)
             out.trusted[w, e] = trusted
-            ok = accepts(few, solved.degenerate[w, e], solved.a0_weight[w, e], fs.guard, trusted)
+            weights = (solved.a0_weight[w, e], fs.min_a0_weight)
+            ok = accepts(few, solved.degenerate[w, e], weights, fs.guard, trusted)
             out.accepted[w, e] = ok
             if ok:
                 for a in range(p):
@@ -540,7 +542,15 @@ def record_setup(
         plan=plan,
         settings=settings_for((st.method, st.scaling), st.rule, cov, s.na, n_channels),
         fsm=FsmSettings(
-            min_rows, st.guard, trusted, st.rule.separation, s.na, s.nb, s.nk, not miso
+            min_rows,
+            st.guard,
+            trusted,
+            st.rule.separation,
+            float(st.rule.min_a0_weight),
+            s.na,
+            s.nb,
+            s.nk,
+            not miso,
         ),
         n_inputs=n_in,
     )

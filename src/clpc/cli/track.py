@@ -114,7 +114,8 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
 
     Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
     OUT/report.html with its figures (trace, fit, data, step, bode, pz .png). Exits 1 when
-    --save was asked for and no update was accepted (there is no model to save).
+    --save was asked for and no update was accepted (there is no model to save), and
+    when the steady-state model is unstable (a pole beyond 1 + 5e-3: nothing is saved).
 
     \b
     Examples:
@@ -130,3 +131,5 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
             f"no update was accepted: there is no model to save to {settings.save} (the "
             "trace and the report were written); see the findings above."
         )
+    if result.save_refused:
+        raise click.ClickException(result.save_refused)

@@ -34,6 +34,7 @@ __all__ = [
     "accepts",
     "is_determined",
     "is_excited",
+    "is_input_relation",
     "is_trusted",
     "transform_mode",
 ]
@@ -55,9 +56,6 @@ CONSTANT_CHANNEL_FRACTION = 1e-28
 CONSTANT_CHANNEL_RELATIVE_STD = 1e-12
 #: Largest eigenvalue ratio of one near-null subspace (cap of the Marchenko-Pastur ratio).
 MAX_DEGENERACY_RATIO = 4.0
-#: An estimate whose ``y(n)`` weight in the solved problem is below this does not
-#: determine ``y(n)``: it has no monic form and the appraiser never accepts it.
-MIN_A0_WEIGHT_ACCEPT = 1e-3
 #: Entries of a unit vector below this are zero when the sign convention picks its pivot.
 SIGN_PIVOT_TOL = 1e-14
 #: A residual variance below this many machine epsilons of ``lambda_max / n`` is rounding,
@@ -93,8 +91,17 @@ class RobustRule:
     min_a0_weight : float
         An eigenvector of the solved scatter matrix is a candidate system relation when
         its unit-free ``y(n)`` weight (:func:`clpc.core.solution.unit_free_weights`) is at
-        least this (0..1). Smaller eigenvectors
-        below the first candidate are relations that do not determine ``y(n)``.
+        least this (0 < value <= 1). Smaller eigenvectors below the first candidate are
+        relations that do not determine ``y(n)``, and a *solution* below it is an input
+        relation (:func:`is_input_relation`): it is counted in ``n_input_relations``, is
+        never determined and never accepted by the appraiser. This is the one threshold
+        of "determines ``y(n)``". Why 0.1: a plant's own relation has a much larger
+        weight (the dryer's windows 0.37-0.44; a second-order plant with poles at
+        ``0.97 +- 0.05j`` about 0.42), while the input-only relations measured were 0.006
+        (``u(n) ~ u(n-1)`` on a drive record, accepted by the 1e-3 rule used before) and
+        0.07-0.09 (a chirp input with the output 100 times the input's size, method
+        ``"paper"``). A slow plant of high order has a small weight of its own (all
+        ``na = 5`` poles near 1: about ``1 / sqrt(252) = 0.063``): lower it there.
     degeneracy_ratio : float, optional
         Eigenvalues within this factor of the candidate's belong to the same near-null
         subspace (the noise cannot tell them apart); the solution is then the minimum-norm
@@ -120,8 +127,13 @@ class RobustRule:
     separation: float = 0.1
 
     def __post_init__(self) -> None:
+        a0 = self.min_a0_weight
+        if not (isinstance(a0, (int, float)) and not isinstance(a0, bool) and 0.0 < a0 <= 1.0):
+            raise ValueError(
+                f"RobustRule.min_a0_weight must be a number in (0, 1]; got {a0!r} (a solution "
+                "with no y(n) weight has no monic form)."
+            )
         for name, low, high in (
-            ("min_a0_weight", 0.0, 1.0),
             ("zero_tol", 0.0, 1.0),
             ("min_output_weight", 0.0, 1.0),
             ("separation", 0.0, 1.0),
@@ -275,13 +287,33 @@ def is_trusted(n_rows: float, need_rows: int, excited: bool, determined: bool) -
 
 
 @register_jitable(error_model="numpy")
+def is_input_relation(a0_weight: float, min_a0_weight: float) -> bool:
+    """The solution hardly involves ``y(n)``: a relation the input (or past) satisfies.
+
+    ``a0_weight`` is the solution's unit-free ``y(n)`` weight
+    (:func:`clpc.core.solution.unit_free_weights`), ``min_a0_weight`` the rule's
+    threshold (:class:`RobustRule`, where its value is argued). Such a solution (e.g.
+    ``u(n) ~ u(n-1)`` for a smooth input) is not the plant: its monic form divides by a
+    ``y(n)`` coefficient near 0 and has arbitrary poles.
+    """
+    return not a0_weight >= min_a0_weight
+
+
+@register_jitable(error_model="numpy")
 def accepts(
-    not_enough: bool, degenerate: bool, a0_weight: float, guard: bool, trusted: bool
+    not_enough: bool,
+    degenerate: bool,
+    weights: tuple[float, float],
+    guard: bool,
+    trusted: bool,
 ) -> bool:
     """The appraiser takes a window's estimate (else it holds the last one).
 
-    Without the guard (the paper's appraiser) every computable estimate is taken; with
-    it only trusted windows (:func:`is_trusted`).
+    ``weights = (a0_weight, min_a0_weight)``: a solution that is an input relation
+    (:func:`is_input_relation`) is never taken, guard or not. Otherwise, without the
+    guard (the paper's appraiser) every computable estimate is taken; with it only trusted
+    windows (:func:`is_trusted`).
     """
-    ok = not not_enough and not degenerate and a0_weight >= MIN_A0_WEIGHT_ACCEPT
+    a0_weight, min_a0_weight = weights
+    ok = not not_enough and not degenerate and not is_input_relation(a0_weight, min_a0_weight)
     return ok and (trusted or not guard)

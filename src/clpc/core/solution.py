@@ -28,6 +28,7 @@ from clpc.core.rules import (
     NO_TRANSFORM,
     SIGN_PIVOT_TOL,
     SolveSettings,
+    is_input_relation,
 )
 
 __all__ = [
@@ -319,7 +320,9 @@ def solve_from_eig(
     Returns
     -------
     tuple
-        ``(c, noise_variance, separation, a0_weight, n_null, n_input, degenerate)``.
+        ``(c, noise_variance, separation, a0_weight, n_null, n_input, degenerate)``;
+        ``n_input`` is at least 1 when the solution itself is an input relation
+        (:func:`clpc.core.rules.is_input_relation`), so it is never determined.
     """
     vals, vecs, raw = eig
     tmat, scales = transform
@@ -332,6 +335,8 @@ def solve_from_eig(
     else:
         n_null, n_input, separation = pick_paper((vals, vecs), tr, s, phi)
     a0_weight = 0.0 if degenerate else unit_free_weights(phi, tr, s.n_out_cols)[0]
+    if not degenerate and is_input_relation(a0_weight, s.min_a0_weight):
+        n_input = max(n_input, 1)  # the solution itself is an input relation
     for a in range(p):  # theta = T phi
         if tr[2]:
             theta[a] = phi[a]

@@ -25,6 +25,7 @@ from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
+from clpc.workflows.save_check import save_refusal
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
 
@@ -95,12 +96,16 @@ class TrackResult:
         Where ``model`` comes from (see :func:`clpc.report.steady_state`).
     files : list of Path
         Files written: trace, figures, report and the saved model.
+    save_refused : str or None
+        Why ``--save`` saved nothing although a model exists (one line, see
+        :func:`clpc.workflows.save_check.save_refusal`); ``None`` otherwise.
     """
 
     summary: dict[str, Any]
     model: LinearModel | None
     model_source: str
     files: list[Path]
+    save_refused: str | None = None
 
 
 def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
@@ -407,10 +412,13 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
         result = _finish(settings, run, trace_file, folder.staging)
         folder.commit()
         files = [folder.final(f) for f in result.files]
+    refused = None
     if settings.save and result.model is not None:
-        save_model(result.model, settings.save)
-        files.append(Path(settings.save))
-    return dataclasses.replace(result, files=files)
+        refused = save_refusal(result.model, settings.save)
+        if refused is None:
+            save_model(result.model, settings.save)
+            files.append(Path(settings.save))
+    return dataclasses.replace(result, files=files, save_refused=refused)
 
 
 def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> TrackResult:
