@@ -37,6 +37,7 @@ __all__ = [
     "sampling_options",
     "save_option",
     "stream_sampling_options",
+    "time_base_options",
 ]
 
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
@@ -136,8 +137,27 @@ def dt_option() -> Decorator:
     )
 
 
+def time_base_options() -> Decorator:
+    """``--time-unit`` and ``--time-rtol``: the one time-base rule of every command."""
+    return combine(
+        click.option(
+            "--time-unit",
+            type=click.Choice(list(TIME_UNITS)),
+            default=None,
+            help="Unit of the --time column (default: from its name, e.g. t_ms is ms; else s).",
+        ),
+        click.option(
+            "--time-rtol",
+            type=click.FloatRange(min=0, min_open=True),
+            default=DEFAULT_TIME_RTOL,
+            show_default=True,
+            help="Largest relative deviation of one time step from the median step.",
+        ),
+    )
+
+
 def stream_sampling_options() -> Decorator:
-    """``--dt`` and ``--time COL`` (into ``time_col``): the sampling of standard input."""
+    """``--dt``, ``--time COL`` (into ``time_col``), ``--time-unit``, ``--time-rtol``."""
     return combine(
         dt_option(),
         click.option(
@@ -145,8 +165,10 @@ def stream_sampling_options() -> Decorator:
             "time_col",
             metavar="COL",
             default=None,
-            help="Column of sample times [s]; must be uniformly spaced.",
+            help="Column of sample times; dt is the mean of its first steps; a gap is "
+            "reported and the grid re-anchored, a stamp off the grid is a malformed line.",
         ),
+        time_base_options(),
     )
 
 
@@ -165,19 +187,7 @@ def sampling_options() -> Decorator:
             default=None,
             help="Column of sample times; dt is its mean step (steps uniform within --time-rtol).",
         ),
-        click.option(
-            "--time-unit",
-            type=click.Choice(list(TIME_UNITS)),
-            default=None,
-            help="Unit of the --time column (default: from its name, e.g. t_ms is ms; else s).",
-        ),
-        click.option(
-            "--time-rtol",
-            type=click.FloatRange(min=0, min_open=True),
-            default=DEFAULT_TIME_RTOL,
-            show_default=True,
-            help="Largest relative deviation of one time step from the median step.",
-        ),
+        time_base_options(),
         click.option(
             "--resample",
             is_flag=True,

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import json
+import os
 import sys
-from collections.abc import Iterator
+from typing import Any
 
 import click
 
-from clpc.cli.errors import ClpcCommand
+from clpc.cli.errors import ClpcCommand, _silence_stdout
 from clpc.cli.options import (
     appraiser_options,
     appraiser_settings,
@@ -18,30 +19,11 @@ from clpc.cli.options import (
     output_option,
     stream_sampling_options,
 )
-from clpc.workflows import StreamSettings, stream_samples
+from clpc.cli.stream_io import EXIT_CLOSED_PIPE, Interrupts, Stopped, stdin_batches
+from clpc.workflows import StreamSettings
+from clpc.workflows.stream_session import LineStream
 
 __all__ = ["stream"]
-
-
-def _stdin_batches() -> Iterator[list[str]]:
-    """Complete lines of standard input, in batches of what has arrived so far.
-
-    ``read1`` returns what the pipe holds (at most 64 KiB) without waiting for more, so a
-    slow producer gets its updates at once and a fast one is processed in vectorised batches.
-    """
-    raw = getattr(sys.stdin, "buffer", None)
-    if raw is None or not hasattr(raw, "read1"):  # a text-only stream
-        for line in iter(sys.stdin.readline, ""):
-            yield [line]
-        return
-    rest = b""
-    while block := raw.read1(1 << 16):
-        lines = (rest + block).split(b"\n")
-        rest = lines.pop()
-        if lines:
-            yield [line.decode("utf-8", errors="replace") for line in lines]
-    if rest:
-        yield [rest.decode("utf-8", errors="replace")]
 
 
 @click.command(cls=ClpcCommand)
@@ -77,9 +59,18 @@ def _stdin_batches() -> Iterator[list[str]]:
     show_default=True,
     help="A malformed line: report it and skip it, or exit 1.",
 )
+@click.option(
+    "--state",
+    "state_file",
+    metavar="FILE",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="Continue from the appraiser saved in FILE (if it exists; its settings are used) "
+    "and save it there when the stream ends, fails or is stopped by a signal.",
+)
 @appraiser_settings()
 @collect("settings", StreamSettings)
-def stream(settings: StreamSettings) -> None:
+def stream(settings: StreamSettings, state_file: str | None) -> None:
     """Run the appraiser on samples from standard input; one JSON line per cluster update.
 
     Each input line is one sample: csv "u,y" (or "u1,u2,y1,y2" with --inputs 2
@@ -90,8 +81,18 @@ def stream(settings: StreamSettings) -> None:
     standard error). Each update is written at once (flushed) with index, time, theta,
     den, num, D, lambda_min, accepted, determined and the other statistics. A malformed
     line is reported on standard error with its line number, then skipped (--on-error
-    skip) or ends the run with exit code 1 (--on-error stop). Exit code 1 as well when
-    no valid sample arrived.
+    skip) or ends the run with exit code 1 (--on-error stop); so is a last line without
+    a newline (cut short). With --time, a gap (dropped samples) is reported once and the
+    grid re-anchored; a stamp that goes back or lands between grid points is a malformed
+    line; the unit comes from the column's name (t_ms is ms) or --time-unit.
+
+    \b
+    Exit codes:
+      0    the stream ended
+      1    a data error, no valid sample, or no update because of the time column
+      2    a usage error (options, columns the header lacks)
+      129  stopped by SIGHUP, 130 by SIGINT, 143 by SIGTERM (state saved first)
+      141  standard output was closed by its reader (e.g. | head)
 
     \b
     Examples:
@@ -99,8 +100,45 @@ def stream(settings: StreamSettings) -> None:
       tail -f log.jsonl | clpc stream --format jsonl --inputs 2 --outputs 2
       cat log.csv | clpc stream -u volt -y pos --time t
     """  # noqa: D301
+    if sys.stdout is None:
+        raise click.ClickException("standard output is closed; nowhere to write the updates.")
+    appraiser = None
+    if state_file is not None and os.path.exists(state_file):
+        from clpc.appraiser import CLPC
+
+        appraiser = CLPC.load(state_file)
+    run = LineStream(settings, appraiser)
+    with Interrupts() as stops:
+        try:
+            skipped, samples = _run(run, stops)
+        except Stopped as stop:
+            _save(run, state_file)
+            click.echo(f"clpc stream: stopped by {stop.name}{_saved(run, state_file)}", err=True)
+            sys.exit(stop.exit_code)
+        except BrokenPipeError:
+            _save(run, state_file)
+            _silence_stdout()
+            sys.exit(EXIT_CLOSED_PIPE)
+        except Exception:
+            _save(run, state_file)
+            raise
+    _save(run, state_file)
+    if skipped:
+        click.echo(f"clpc stream: {skipped} malformed line(s) skipped", err=True)
+    if not samples:
+        raise click.ClickException(
+            "no valid sample arrived on standard input; check the format (--format), the "
+            "columns (--input/--output, --inputs/--outputs) and the lines reported above."
+        )
+    problem = run.clock_problem()
+    if problem:
+        raise click.ClickException(problem)
+
+
+def _run(run: LineStream, stops: Interrupts) -> tuple[int, int]:
+    """Stream standard input through ``run``; the malformed lines and samples counted."""
     skipped = samples = 0
-    for batch in stream_samples(_stdin_batches(), settings):
+    for batch in run.run(stdin_batches(stops)):
         for message in batch.notes:
             click.echo(f"clpc stream: {message}", err=True)
         for message in batch.skipped:
@@ -110,10 +148,16 @@ def stream(settings: StreamSettings) -> None:
         if batch.records:
             sys.stdout.write("".join(json.dumps(r, allow_nan=False) + "\n" for r in batch.records))
             sys.stdout.flush()
-    if skipped:
-        click.echo(f"clpc stream: {skipped} malformed line(s) skipped", err=True)
-    if not samples:
-        raise click.ClickException(
-            "no valid sample arrived on standard input; check the format (--format), the "
-            "columns (--input/--output, --inputs/--outputs) and the lines reported above."
-        )
+        stops.check()
+    return skipped, samples
+
+
+def _save(run: LineStream, state_file: str | None) -> None:
+    if state_file is not None and run.appraiser is not None:
+        run.appraiser.save(state_file)
+
+
+def _saved(run: LineStream, state_file: Any) -> str:
+    if state_file is None or run.appraiser is None:
+        return ""
+    return f"; state saved to {state_file}"

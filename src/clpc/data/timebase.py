@@ -28,6 +28,8 @@ __all__ = [
     "check_time_base",
     "measure_time_base",
     "resample_to_grid",
+    "rounded_step",
+    "step_deviation",
     "time_unit",
 ]
 
@@ -87,6 +89,46 @@ def time_unit(unit: str | None, column: str) -> str:
     return found.pop() if len(found) == 1 else "s"
 
 
+def rounded_step(step: float) -> float:
+    """A mean step rounded to 12 significant digits when that changes it by at most 1e-9.
+
+    Parameters
+    ----------
+    step : float
+        A mean time step [s].
+
+    Returns
+    -------
+    float
+        The sample time [s]: ``0.009999999999999998`` becomes ``0.01``.
+    """
+    rounded = float(f"{step:.12g}")
+    return rounded if abs(rounded - step) <= 1e-9 * abs(step) else float(step)
+
+
+def step_deviation(step: Any, typical: float) -> Any:
+    """Relative deviation of time steps from the typical step: the one tolerance test.
+
+    A step is on the time base when this is at most ``time_rtol`` (every reader, and
+    :class:`clpc.data.timegrid.TimeGrid` for a stream).
+
+    Parameters
+    ----------
+    step : float or ndarray
+        Time steps [s] (or steps counted in sample times, with ``typical`` a whole number).
+    typical : float
+        The typical step, in the same unit.
+
+    Returns
+    -------
+    float or ndarray
+        ``|step - typical| / |typical|`` (infinite for a typical step of 0).
+    """
+    if not typical:
+        return np.full(np.shape(step), np.inf) if np.ndim(step) else float("inf")
+    return np.abs(np.subtract(step, typical)) / abs(typical)
+
+
 @dataclass(frozen=True)
 class TimeBase:
     """What a time column measured.
@@ -135,10 +177,9 @@ def measure_time_base(t: Any) -> TimeBase:
     t = np.asarray(t, dtype=np.float64)
     steps = np.diff(t)
     typical = float(np.median(steps))
-    dev = np.abs(steps - typical) / abs(typical) if typical else np.full(steps.shape, np.inf)
+    dev = step_deviation(steps, typical)
     step = float((t[-1] - t[0]) / (t.size - 1))
-    rounded = float(f"{step:.12g}")  # 0.009999999999999998 -> 0.01
-    dt = rounded if abs(rounded - step) <= 1e-9 * abs(step) else step
+    dt = rounded_step(step)
     grid = t[0] + np.arange(t.size) * step
     drift = float(np.max(np.abs(t - grid)) / abs(step)) if step else float("inf")
     worst = int(np.argmax(dev))

@@ -8,23 +8,13 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
-import numpy as np
-
-from clpc.appraiser import CLPC
 from clpc.core.checks import check_choice, check_int, check_positive
-from clpc.core.compact import compact_repr
-from clpc.data import DataError
-from clpc.report import update_records
+from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
 from clpc.workflows.common import AppraiserSettings, SamplingConflictError, SettingsError
-from clpc.workflows.stream_lines import (
-    LineReader,
-    SampleClock,
-    Timed,
-    parse_csv_sample,
-    parse_jsonl_sample,
-)
+from clpc.workflows.stream_lines import parse_csv_sample, parse_jsonl_sample
+from clpc.workflows.stream_session import LineStream, StreamBatch
 
 __all__ = [
     "StreamBatch",
@@ -58,8 +48,14 @@ class StreamSettings:
         digits; JSON keys (one number each). Empty: the first ``n_in`` fields are the
         inputs and the next ``n_out`` the outputs (csv), keys ``"u"``/``"y"`` (JSON).
     time_col : str, optional
-        Column (csv name or index, JSON key) of sample times [s]: the sample time is the
-        step between the first two samples; a sample off that grid is a malformed line.
+        Column (csv name or index, JSON key) of sample times: the rule of
+        :mod:`clpc.data.timegrid` (the mean of the first steps; a gap is reported and the
+        grid re-anchored; a stamp that does not increase or lands between grid points is a
+        malformed line).
+    time_unit : {"s", "ms", "us"}, optional
+        Unit of ``time_col``; default from its name (``t_ms`` is in ms), else seconds.
+    time_rtol : float
+        Largest relative deviation of one time step from the typical step.
     """
 
     appraiser: AppraiserSettings = field(default_factory=AppraiserSettings)
@@ -71,6 +67,8 @@ class StreamSettings:
     inputs: tuple[str, ...] = ()
     outputs: tuple[str, ...] = ()
     time_col: str | None = None
+    time_unit: str | None = None
+    time_rtol: float = DEFAULT_TIME_RTOL
 
     def __post_init__(self) -> None:
         if self.dt is not None:
@@ -79,6 +77,11 @@ class StreamSettings:
         check_int(self.n_out, "n_out", 1)
         check_choice(self.fmt, "fmt", ("csv", "jsonl"))
         check_choice(self.on_error, "on_error", ("skip", "stop"))
+        check_positive(self.time_rtol, "time_rtol")
+        if self.time_unit is not None:
+            check_choice(self.time_unit, "time_unit", tuple(TIME_UNITS))
+            if self.time_col is None:
+                raise SettingsError("--time-unit is the unit of the --time column; give --time.")
         if bool(self.inputs) != bool(self.outputs):
             raise SettingsError(
                 "give both the input and the output columns (--input and --output), or "
@@ -105,66 +108,6 @@ class StreamSettings:
         if self.inputs:
             return len(self.inputs), len(self.outputs)
         return self.n_in, self.n_out
-
-
-@compact_repr
-@dataclass(frozen=True)
-class StreamBatch:
-    """What one batch of lines gave.
-
-    Attributes
-    ----------
-    records : list of dict
-        One :func:`clpc.report.update_records` entry per cluster update (JSON-safe).
-    skipped : list of str
-        One message per malformed line skipped: ``"line N: what: 'text'"``.
-    notes : list of str
-        Lines read as something other than a sample, e.g. ``"line 1: header (column
-        names): u, y"``.
-    samples : int
-        Valid samples in the batch.
-    """
-
-    records: list[dict[str, Any]] = field(default_factory=list)
-    skipped: list[str] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    samples: int = 0
-
-
-def _push(appraiser: CLPC, samples: list[Sample], n_in: int, n_out: int) -> list[dict[str, Any]]:
-    if not samples:
-        return []
-    u = np.asarray([s[0] for s in samples]).reshape(-1, n_in)
-    y = np.asarray([s[1] for s in samples]).reshape(-1, n_out)
-    trace = appraiser.push(u, y)
-    return update_records(trace) if len(trace) else []
-
-
-class _Session:
-    """The appraiser of one stream; built once the data's sample time is known."""
-
-    def __init__(self, settings: StreamSettings) -> None:
-        self.s = settings
-        self.n_in, self.n_out = settings.channels
-        self.clock = SampleClock() if settings.time_col is not None else None
-        self.appraiser: CLPC | None = None
-        self.waiting: list[Sample] = []  # samples before the sample time is known
-
-    def accept(self, sample: Timed) -> None:
-        """Check the sample's time (``ValueError`` when off the grid)."""
-        if self.clock is not None:
-            assert sample[2] is not None
-            self.clock.check(sample[2])
-
-    def push(self, samples: list[Sample]) -> list[dict[str, Any]]:
-        if self.appraiser is None:
-            if self.clock is not None and self.clock.dt is None:
-                self.waiting += samples
-                return []
-            dt = self.clock.dt if self.clock is not None else self.s.dt
-            self.appraiser = self.s.appraiser.build(dt)
-            samples, self.waiting = self.waiting + samples, []
-        return _push(self.appraiser, samples, self.n_in, self.n_out)
 
 
 def stream_samples(
@@ -199,26 +142,4 @@ def stream_samples(
     SettingsError
         Named columns that the header does not hold (or no header to find them in).
     """
-    session = _Session(settings)
-    reader = LineReader(settings)
-    for batch in batches:
-        samples: list[Sample] = []
-        skipped: list[str] = []
-        for line in batch:
-            try:
-                sample = reader.read(line)
-                if sample is not None:
-                    session.accept(sample)
-            except ValueError as exc:
-                if isinstance(exc, SettingsError):
-                    raise
-                if settings.on_error == "stop":
-                    notes, reader.notes = reader.notes, []
-                    yield StreamBatch(session.push(samples), [], notes, len(samples))
-                    raise DataError(str(exc)) from None
-                skipped.append(str(exc))
-                continue
-            if sample is not None:
-                samples.append((sample[0], sample[1]))
-        notes, reader.notes = reader.notes, []
-        yield StreamBatch(session.push(samples), skipped, notes, len(samples))
+    yield from LineStream(settings).run(batches)

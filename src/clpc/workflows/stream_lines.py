@@ -13,11 +13,17 @@ from typing import Any
 from clpc.io.errors import is_number, parse_number
 from clpc.workflows.common import SettingsError
 
-__all__ = ["LineReader", "SampleClock", "Timed", "parse_csv_sample", "parse_jsonl_sample"]
+__all__ = ["CutLine", "LineReader", "Timed", "parse_csv_sample", "parse_jsonl_sample"]
 
 Sample = tuple[list[float], list[float]]
 #: a sample with its time (``None`` without a time column)
 Timed = tuple[list[float], list[float], float | None]
+
+
+class CutLine(str):
+    """The last line of a stream when it had no newline: a write cut short, not a sample."""
+
+    __slots__ = ()
 
 
 def _finite(values: list[float]) -> None:
@@ -156,12 +162,29 @@ class LineReader:
         if settings.fmt == "csv" and wanted and all(w.isdigit() for w in wanted):
             self.use = [int(w) for w in wanted]
 
-    def read(self, line: str) -> Timed | None:
-        """The sample of the next line, or None; ``ValueError("line N: ...")`` if malformed."""
+    @property
+    def time_name(self) -> str:
+        """The time column's name (from the header for a column given by index)."""
+        col = str(self.s.time_col)
+        if self.names is not None and self.use is not None and col.isdigit():
+            return self.names[self.use[-1]]
+        return col
+
+    def read(self, line: str, complete: bool = True) -> Timed | None:
+        """The sample of the next line, or None; ``ValueError("line N: ...")`` if malformed.
+
+        ``complete=False``: the last line of the stream had no newline (a write cut short):
+        it is not taken as a sample (a ``ValueError``).
+        """
         self.no += 1
         text = line.strip().lstrip("\ufeff")
         if not text or text.startswith("#"):
             return None
+        if not complete:
+            raise ValueError(
+                f"line {self.no}: the last line has no newline (cut short?); not used as a "
+                f"sample: {text[:80]!r}"
+            )
         try:
             if self.header_possible:
                 self.header_possible = False
@@ -196,6 +219,13 @@ class LineReader:
                     f"{', '.join(names)}."
                 )
             self.use = [names.index(w) for w in self.wanted]
+        beyond = [i for i in self.use or () if i >= len(names)]
+        if beyond:
+            raise SettingsError(
+                f"column index {beyond[0]} is past the header's {len(names)} columns "
+                f"(line {self.no}: {', '.join(names)}); 0-based indices go up to "
+                f"{len(names) - 1}."
+            )
         self.names = names
         self.notes.append(f"line {self.no}: header (column names): {', '.join(names)}")
         return True
@@ -225,30 +255,3 @@ class LineReader:
         n = self.n_in + self.n_out
         t = values[n] if len(values) > n else None
         return values[: self.n_in], values[self.n_in : n], t
-
-
-class SampleClock:
-    """The sample time of a stream from its time column (the first two samples)."""
-
-    def __init__(self, rtol: float = 1e-6) -> None:
-        self.rtol = rtol
-        self.first: float | None = None
-        self.dt: float | None = None
-        self.count = 0
-
-    def check(self, t: float) -> None:
-        """Accept the time of the next sample; ``ValueError`` when it is off the grid."""
-        if self.first is None:
-            self.first, self.count = t, 1
-            return
-        if self.dt is None:
-            if not t > self.first:
-                raise ValueError(f"time {t!r} does not increase (previous {self.first!r})")
-            self.dt, self.count = t - self.first, 2
-            return
-        want = self.first + self.count * self.dt
-        if abs(t - want) > self.rtol * self.dt * max(1, self.count):
-            raise ValueError(
-                f"time {t!r} is off the uniform grid (expected {want!r}, step {self.dt!r} s)"
-            )
-        self.count += 1
