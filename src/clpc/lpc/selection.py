@@ -44,7 +44,7 @@ thirds and scored on the first third), and folds scored backward in time were th
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -52,18 +52,16 @@ from threadpoolctl import threadpool_limits
 
 from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
-from clpc.data import DataError, IOData, as_iodata
+from clpc.data import DataError, as_iodata
 from clpc.lpc import heldout
+from clpc.lpc.candidates import candidate_rows
 from clpc.lpc.choice import choose, guarded
 from clpc.lpc.comparison import (
-    FAMILIES,
-    candidate,
     final_model,
     key,
     make,
     rolling_origin,
     stable_refits,
-    subspace_structure,
 )
 from clpc.lpc.eiv import EivCheck, check_eiv
 from clpc.lpc.gain_choice import prefer_determined_gain
@@ -240,7 +238,7 @@ def identify(
         k = heldout.horizon(lowest, folds[0][1].n_samples)
     k = check_int(k, "k", 1)
     automatic = order == "auto" and na is None and nb is None
-    rows, last_oe = _candidates(folds, short, (mode, k, automatic), say)
+    rows, last_oe = candidate_rows(folds, short, (mode, k, automatic), say)
     # the reference: least squares at the screen's choice (the first shortlisted structure)
     guarded(rows, {r["output"]: r["windows"] for r in rows if _is(r, "arx", short[0])})
     where, first = choose(rows, estimator, data.output_names)
@@ -278,58 +276,3 @@ def identify(
 def _is(row: dict[str, Any], name: str, structure: Structure) -> bool:
     """Whether ``row`` is estimator ``name`` at ``structure``."""
     return row["estimator"] == name and key(row) == (structure.na, structure.nb, structure.nk)
-
-
-def _subspace_structures(
-    data: IOData, short: list[Structure], mode: str, automatic: bool
-) -> list[Structure]:
-    """The subspace candidates: its own order choice and the shortlist's state dimensions.
-
-    ``automatic`` (the orders are searched): ``Subspace(order="auto")`` on ``data`` (the
-    last origin's fitted part) with and without feedthrough (its singular values and
-    held-out check, :mod:`clpc.lpc.subspace_order`), then the state dimension each
-    shortlisted structure's lags need (``max(na, nb + 1)``, with its delay); otherwise
-    (an order given) the shortlist's ``na`` only. Each structure once.
-    """
-    if not automatic:
-        return list(dict.fromkeys(subspace_structure(s.na, s.nk) for s in short))
-    own = []
-    for nk in (0, max(short[0].nk, 1)):
-        try:
-            est = make("subspace", subspace_structure(1, nk), mode)
-            fitted = replace(est, order="auto").fit(data)
-            own.append(subspace_structure(fitted.structure.na, nk))
-        except (ModelError, DataError, np.linalg.LinAlgError):
-            continue
-    shaped = [subspace_structure(max(s.na, s.nb + 1), s.nk) for s in short]
-    return list(dict.fromkeys(own + shaped))
-
-
-def _candidates(
-    folds: list[Any],
-    short: list[Structure],
-    opts: tuple[str, int, bool],
-    say: Callable[[str], None],
-) -> tuple[list[dict[str, Any]], dict[Structure, LinearModel]]:
-    """Every estimator at every shortlisted structure, scored at the origins.
-
-    Returns the rows (``n_params`` added) and each structure's OE fit at the last origin.
-    """
-    mode, k, automatic = opts
-    n_in = folds[0][0].n_inputs
-    blocks = n_in if mode == "miso" else 1
-    rows: list[dict[str, Any]] = []
-    last_oe: dict[Structure, LinearModel] = {}
-    shapes = ", ".join(f"na={s.na} nb={s.nb} nk={s.nk}" for s in short)
-    for name in FAMILIES:
-        where = short
-        if name == "subspace":
-            where = _subspace_structures(folds[-1][0], short, mode, automatic)
-            shapes = ", ".join(f"order {s.na} nk={s.nk}" for s in where)
-        say(f"{name.upper()}: {shapes} at {len(folds)} origins")
-        for s in where:
-            got, model = candidate(name, s, mode, (folds, k))
-            rows += [r | {"n_params": s.na + blocks * (s.nb + 1)} for r in got]
-            if name == "oe" and model is not None:
-                last_oe[s] = model
-    return rows, last_oe
