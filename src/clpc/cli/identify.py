@@ -19,12 +19,13 @@ from clpc.cli.options import (
     input_option,
     json_option,
     method_option,
+    na_nb_options,
     output_option,
     record_settings,
     sampling_options,
     save_option,
 )
-from clpc.cli.output import echo_json
+from clpc.cli.output import echo_json, warn_unnamed_time
 from clpc.core.output_folder import OutputFolder
 from clpc.lpc.reasons import pct
 from clpc.lpc.selection import ESTIMATORS
@@ -125,19 +126,7 @@ def _comparison_lines(result: IdentifyResult) -> list[str]:
     "the free-run and the k-step prediction fit (k: one dominant time constant), unstable "
     "orders rejected (validation); BIC, AIC or the paper's Remark 1.",
 )
-@click.option(
-    "--na",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Output order (A has na + 1 coefficients); overrides --order for A.",
-)
-@click.option(
-    "--nb",
-    type=click.IntRange(min=0),
-    default=None,
-    help="Input order (each B has nb + 1 coefficients: MATLAB's arx nb is this + 1); "
-    "overrides --order for B.",
-)
+@na_nb_options()
 @click.option(
     "--nk",
     type=DelayType(),
@@ -204,6 +193,7 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
     """  # noqa: D301
     # the report's folder is locked first: a second run into it is refused before fitting
     folder = OutputFolder(report, "--report") if report else None
+    warn_unnamed_time(settings.record)
     with folder if folder is not None else contextlib.nullcontext():
         result = identify_file(settings, _progress())
         if as_json:

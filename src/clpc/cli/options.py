@@ -30,6 +30,7 @@ __all__ = [
     "json_option",
     "method_option",
     "model_argument",
+    "na_nb_options",
     "nk_option",
     "out_dir_option",
     "output_option",
@@ -222,6 +223,25 @@ def method_option(help: str | None = "LPC solution (see clpc.LPC).") -> Decorato
     )
 
 
+def na_nb_options() -> Decorator:
+    """``--na`` and ``--nb``: the orders of A and B, each overriding ``--order`` for its own."""
+    return combine(
+        click.option(
+            "--na",
+            type=click.IntRange(min=1),
+            default=None,
+            help="Output order (A has na + 1 coefficients); overrides --order for A.",
+        ),
+        click.option(
+            "--nb",
+            type=click.IntRange(min=0),
+            default=None,
+            help="Input order (each B has nb + 1 coefficients: MATLAB's arx nb is this + 1); "
+            "overrides --order for B.",
+        ),
+    )
+
+
 def nk_option() -> Decorator:
     """``--nk``: the input delay."""
     return click.option(
@@ -243,8 +263,9 @@ def appraiser_options() -> Decorator:
             type=click.IntRange(min=1),
             default=2,
             show_default=True,
-            help="Model order N (na = nb = N), as in clpc identify.",
+            help="Model order N (na = nb = N unless --na/--nb are given), as in clpc identify.",
         ),
+        na_nb_options(),
         click.option(
             "--window-size",
             "-w",

@@ -1,4 +1,4 @@
-"""Printing: JSON objects, and tables as CSV on standard output."""
+"""Printing: JSON objects, tables as CSV on standard output, and a hint on the time base."""
 
 from __future__ import annotations
 
@@ -11,8 +11,11 @@ import click
 import numpy as np
 
 from clpc.core.jsonable import jsonable
+from clpc.data.timebase import time_like
+from clpc.io import table_columns
+from clpc.workflows import RecordSpec
 
-__all__ = ["echo_json", "write_csv"]
+__all__ = ["echo_json", "warn_unnamed_time", "write_csv"]
 
 
 def echo_json(obj: Any, default: Callable[[Any], Any] | None = None) -> None:
@@ -27,3 +30,26 @@ def write_csv(names: list[str], array: np.ndarray, rows_per_write: int = 10_000)
         rows = array[start : start + rows_per_write].tolist()
         sys.stdout.write("".join(",".join(map(repr, row)) + "\n" for row in rows))
     sys.stdout.flush()
+
+
+def warn_unnamed_time(record: RecordSpec) -> None:
+    """One line on stderr when a column is named like sample times but neither dt nor it is given.
+
+    Without ``--time``/``--dt`` the sample time is 1 s; beside a column named ``t``,
+    ``t_ms``, ``timestamp``... (:func:`clpc.data.timebase.time_like`) that is rarely meant.
+    """
+    if record.dt is not None or record.time_col is not None:
+        return
+    used = {*record.inputs, *record.outputs}
+    names = table_columns(record.file, record.skip_rows)
+    if any(c not in names and not c.isdigit() for c in used):
+        return  # a column is missing: the reader's one-line error says so, alone
+    for name in names:
+        unit = time_like(name)
+        if unit is not None and name not in used:
+            click.echo(
+                f"warning: column {name!r} looks like sample times [{unit}] but neither --time "
+                f"nor --dt was given, so dt = 1 s is used; use --time {name} (or --dt).",
+                err=True,
+            )
+            return

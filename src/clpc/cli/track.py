@@ -21,6 +21,7 @@ from clpc.cli.options import (
     sampling_options,
     save_option,
 )
+from clpc.cli.output import warn_unnamed_time
 from clpc.report import format_model_summary
 from clpc.workflows import (
     Chunk,
@@ -77,6 +78,8 @@ def _print_result(result: TrackResult) -> None:
         click.echo("did not converge (no quasi-constant phase)")
     for line in summary["findings"]:
         click.echo(f"  {line}")
+    if summary.get("advice"):
+        click.echo(summary["advice"])
     if summary["model"] is not None:
         click.echo(f"model ({result.model_source}):")
         click.echo(format_model_summary(summary["model"]))
@@ -122,6 +125,7 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
       clpc track servo.csv -u torque -y position --time t --out run1/
       clpc track big.parquet -u u -y y --dt 0.001 --decimate-to 0.01 --out run2/ --progress
     """  # noqa: D301
+    warn_unnamed_time(settings.record)
     show = progress if progress is not None else sys.stderr.isatty()
     bar = _progress_bar(settings.record.file, settings.record.skip_rows) if show else None
     result = track_file(settings, bar)

@@ -30,6 +30,7 @@ __all__ = [
     "resample_to_grid",
     "rounded_step",
     "step_deviation",
+    "time_like",
     "time_unit",
 ]
 
@@ -87,6 +88,30 @@ def time_unit(unit: str | None, column: str) -> str:
     words = [w for w in re.split(r"[^a-zµ]+", str(column).lower()) if w]
     found = {_UNIT_WORDS[w] for w in words[1:] if w in _UNIT_WORDS}  # "s" alone is a name
     return found.pop() if len(found) == 1 else "s"
+
+
+#: first words of a column name that says it holds sample times (``t``, ``time_us``)
+_TIME_WORDS = ("t", "time", "timestamp")
+
+
+def time_like(column: str) -> str | None:
+    """The unit of a column named like sample times (``t``, ``t_ms``, ``timestamp``), else None.
+
+    Parameters
+    ----------
+    column : str
+        A column's name: a time word (``t``, ``time``, ``timestamp``), then at most unit words
+        (the rule of :func:`time_unit`), e.g. ``t_s``, ``time[ms]``, ``time_us``.
+
+    Returns
+    -------
+    str or None
+        ``"s"``, ``"ms"`` or ``"us"``; ``None`` for any other name (``t1``, ``torque``).
+    """
+    words = [w for w in re.split(r"[^a-zµ0-9]+", str(column).lower()) if w]
+    if not words or words[0] not in _TIME_WORDS or any(w not in _UNIT_WORDS for w in words[1:]):
+        return None
+    return time_unit(None, column)
 
 
 def rounded_step(step: float) -> float:

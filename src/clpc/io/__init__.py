@@ -20,7 +20,7 @@ Where each job lives (one module each):
 """
 
 from clpc.io.errors import DataFileNotFoundError
-from clpc.io.loading import iter_table_chunks, read_table
+from clpc.io.loading import iter_table_chunks, read_table, table_columns
 from clpc.io.model_files import ModelFileError, load_model, save_model
 from clpc.io.records import load_iodata
 from clpc.io.table import Table
@@ -35,5 +35,6 @@ __all__ = [
     "load_model",
     "read_table",
     "save_model",
+    "table_columns",
     "write_table",
 ]

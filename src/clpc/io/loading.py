@@ -29,7 +29,7 @@ from clpc.io.parquet import parquet_source
 from clpc.io.table import Chunks, Columns, PathLike, Table, located_table
 from clpc.io.text_reader import text_source
 
-__all__ = ["iter_table_chunks", "read_table"]
+__all__ = ["iter_table_chunks", "read_table", "table_columns"]
 
 _READ_CHUNK = 200_000
 
@@ -210,3 +210,28 @@ def iter_table_chunks(
             raise _no_rows(src.path)
 
     return generate()
+
+
+def table_columns(path: PathLike, skip_rows: int = 0) -> list[str]:
+    """The names of every column of a regular data file, reading no data (``[]`` if unknown).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A data file of any format :func:`read_table` reads; a pipe or FIFO gives ``[]``
+        (it cannot be read twice).
+    skip_rows : int
+        Lines passed over at the top of a text file.
+
+    Returns
+    -------
+    list of str
+        Column names (text files without a header: ``col0, col1, ...``); ``[]`` when the
+        file cannot be opened or read (the reader proper reports that).
+    """
+    try:
+        if not Path(path).is_file():
+            return []
+        return list(_open_source(path, None, None, None, True, skip_rows).names)
+    except (DataError, OSError, ValueError):
+        return []

@@ -108,7 +108,10 @@ def write_track_report(
     settings : mapping, optional
         Settings shown, folded, at the end (e.g. :meth:`clpc.CLPC.config` and the file).
     summary : mapping, optional
-        :func:`trace_summary` of ``trace`` (computed when omitted).
+        :func:`trace_summary` of ``trace`` (computed when omitted); its ``advice`` (one
+        paragraph on what would help when the data cannot decide, see
+        :func:`clpc.workflows.track_advice.excitation_advice`), when present, leads the
+        result.
     data : IOData, optional
         Measured record (at the trace's sample time) to compare the model with.
     data_note : str
@@ -157,6 +160,8 @@ def write_track_report(
         sections += more
     else:
         result.text = "The figure of the trace below shows why no estimate was accepted."
+    if summary.get("advice"):
+        result.text = "\n\n".join(t for t in (summary["advice"], result.text) if t)
     plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     files.append(trace_png)
     sections.append(

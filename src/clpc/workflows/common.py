@@ -203,6 +203,9 @@ class AppraiserSettings:
         Lag vectors between updates, at least 1.
     nk : int
         Input delay in samples.
+    na, nb : int, optional
+        Orders of A (at least 1) and of each B (at least 0); each overrides ``order`` for
+        its own polynomial (``None``: ``order``).
     decimate_to : float, optional
         Sample time [s] the appraiser works at (an integer multiple of the data's; the data
         are low-pass filtered and decimated).
@@ -220,12 +223,18 @@ class AppraiserSettings:
     decimate_to: float | None = None
     method: Method = "robust"
     guard: bool = True
+    na: int | None = None
+    nb: int | None = None
 
     def __post_init__(self) -> None:
         check_int(self.order, "order", 1)
         check_int(self.window_size, "window_size", 2)
         check_int(self.cluster_size, "cluster_size", 1)
         check_int(self.nk, "nk", 0)
+        if self.na is not None:
+            check_int(self.na, "na", 1)
+        if self.nb is not None:
+            check_int(self.nb, "nb", 0)
         _optional_positive(self.decimate_to, "decimate_to")
         check_choice(self.method, "method", METHODS)
         check_bool(self.guard, "guard")
@@ -249,6 +258,8 @@ class AppraiserSettings:
             cluster_size=self.cluster_size,
             dt=data_dt if data_dt is not None else (1.0 if self.decimate_to else None),
             decimate_to=self.decimate_to,
+            na=self.na,
+            nb=self.nb,
             nk=self.nk,
             method=self.method,
             guard=self.guard,

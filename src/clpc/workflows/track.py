@@ -26,6 +26,7 @@ from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 from clpc.workflows.save_check import save_refusal
+from clpc.workflows.track_advice import excitation_advice
 
 __all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
 
@@ -435,6 +436,10 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
         **run.appraiser.config(),
     }
     summary = trace_summary(whole)
+    record = settings.record
+    command = {"file": file, "inputs": record.inputs, "outputs": record.outputs}
+    u_tail = run.tail.rows[:, : len(record.inputs)]
+    summary["advice"] = excitation_advice(whole, u_tail, settings.appraiser.window_size, command)
     model, source = steady_state(whole)
     report = write_track_report(
         out,
