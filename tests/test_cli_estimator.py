@@ -10,6 +10,7 @@ from click.testing import CliRunner
 import clpc
 import clpc.datasets as ds
 from clpc.cli import cli
+from clpc.lpc.reasons import pct
 
 DRYER = str(ds.path("dryer"))
 
@@ -53,6 +54,12 @@ def test_estimator_lpc_is_the_paper_estimator_alone():
     res = run("identify", DRYER, "-u", "u", "-y", "y", "--estimator", "lpc", "--order", "2")
     assert res.exit_code == 0 and "estimator comparison" not in res.output
     assert "LPC" in res.output and "nk=" in res.output
+    # its delay scan (--nk auto, the default) is printed with the library's numbers
+    scan = clpc.select_delay(ds.load("dryer"), delays=range(6), estimator=clpc.LPC(order=2))
+    line = next(x for x in res.output.splitlines() if x.startswith("delay selection"))
+    for d, fit in zip(scan.delays, scan.validation_fit, strict=True):
+        assert f"nk={d}: {pct(fit)}" in line
+    assert line.endswith(f"-> nk={scan.best}")
 
 
 def test_bad_combinations_are_refused():

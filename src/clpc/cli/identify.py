@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import math
 import sys
 import time
 from collections.abc import Callable
@@ -52,6 +53,18 @@ def _selection_line(result: IdentifyResult) -> str:
     )
     line = f"order selection ({what}): {table} -> N={sel.best}"
     return f"{line}\n  {sel.reason}" if sel.reason else line
+
+
+def _delay_line(scan: dict[str, Any]) -> str:
+    """LPC's delay scan on one line (``--estimator lpc --nk auto``)."""
+    fits = ", ".join(  # a diverging fit is None in the JSON-safe summary
+        f"nk={d}: {pct(-math.inf if v is None else v)}"
+        for d, v in zip(scan["delays"], scan["validation_fit"], strict=True)
+    )
+    return (
+        "delay selection (held-out k-step prediction fit %, the smallest delay within 1 point "
+        f"of the best): {fits} -> nk={scan['best']}"
+    )
 
 
 class DelayType(click.ParamType):
@@ -203,6 +216,8 @@ def identify(settings: IdentifySettings, as_json: bool, report: str | None) -> N
             click.echo(line)
         if result.comparison is not None:
             click.echo("\n".join(_comparison_lines(result)))
+        if "delay_selection" in result.summary:
+            click.echo(_delay_line(result.summary["delay_selection"]))
         if result.selection is not None:
             click.echo(_selection_line(result))
         click.echo(format_model_summary(result.summary, lead=False))

@@ -184,12 +184,14 @@ def identify_file(
     if settings.compares:
         return _compare(settings, data, progress)
     nk = settings.nk
+    delay = None
     if nk == "auto":
         first = 2 if settings.order == "auto" else settings.order
         delays = range(settings.max_delay + 1)
-        nk = select_delay(
+        delay = select_delay(
             data, delays=delays, estimator=LPC(order=first, method=settings.method)
-        ).best
+        )
+        nk = delay.best
     estimator = LPC(
         nk=nk, method=settings.method, mimo=settings.mimo, na=settings.na, nb=settings.nb
     )
@@ -217,6 +219,10 @@ def identify_file(
                 "best": selection.best,
                 "reason": selection.reason,
             }
+        )
+    if delay is not None:
+        summary["delay_selection"] = jsonable(
+            {"delays": delay.delays, "validation_fit": delay.validation_fit, "best": delay.best}
         )
     if settings.save:
         save_model(model, settings.save)
