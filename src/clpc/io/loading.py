@@ -24,6 +24,7 @@ from clpc.data import DataError
 from clpc.io.errors import show
 from clpc.io.formats import check_file, file_kind
 from clpc.io.mat_files import mat_source
+from clpc.io.npz_members import check_load
 from clpc.io.numpy_files import npy_source, npz_source
 from clpc.io.parquet import parquet_source
 from clpc.io.table import Chunks, Columns, PathLike, Table, located_table
@@ -141,7 +142,10 @@ def read_table(
     src = _open_source(path, columns, delimiter, header, allow_missing, skip_rows, whole=True)
     parts: list[np.ndarray] = []
     lines: list[np.ndarray] = []
+    held = 0
     for values, where in src.chunks(_READ_CHUNK):
+        held += values.size
+        check_load(held, show(src.path), "the selected columns")
         parts.append(values)
         if where is not None:
             lines.append(where)

@@ -5,7 +5,9 @@ nothing about its size in memory (4.6 MB of zeros can hold 2e8 values, 1.6 GB as
 :func:`npz_members` reads only each member's header (dtype and shape); :func:`member_rows`
 then decompresses one block of rows at a time, so memory stays bounded by the chunk. A
 2-D member stored in Fortran order has its rows scattered over the member: it is loaded
-whole, and only when it fits :func:`max_load_bytes`.
+whole, and only when it fits :func:`max_load_bytes`. Before any data is read, the members'
+sizes (from their headers and the zip directory) are checked against the read limit
+(``CLPC_MAX_READ_BYTES``, :mod:`clpc.io.budget`) and their columns against the column limit.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import IO
 import numpy as np
 
 from clpc.data import DataError
+from clpc.io.budget import READ_ENV, check_columns, limit, read_too_much
 
 __all__ = ["LIMIT_ENV", "Member", "check_load", "max_load_bytes", "member_rows", "npz_members"]
 
@@ -99,12 +102,17 @@ def npz_members(path: Path, source: str) -> list[Member]:
     ------
     DataError
         Not a zip archive, a member that is not a ``.npy`` array, an object (pickled)
-        array.
+        array, members that decompress beyond the read limit or hold more columns than
+        the column limit (:mod:`clpc.io.budget`).
     """
     out = []
+    budget = limit(READ_ENV)
     try:
         with zipfile.ZipFile(path) as zf:
-            for name in zf.namelist():
+            infos = zf.infolist()
+            if sum(info.file_size for info in infos) > budget:
+                raise read_too_much(source, budget)
+            for name in (info.filename for info in infos):
                 with zf.open(name) as fh:
                     shape, fortran, dtype = _header(fh)
                 if dtype.hasobject:
@@ -118,6 +126,9 @@ def npz_members(path: Path, source: str) -> list[Member]:
         if isinstance(exc, DataError):
             raise
         raise DataError(f"{source} is not a valid .npz file ({exc}).") from None
+    if sum(m.size * m.dtype.itemsize for m in out) > budget:
+        raise read_too_much(source, budget)
+    check_columns(max([len(out), *(math.prod(m.shape[1:]) for m in out)]), source)
     return out
 
 

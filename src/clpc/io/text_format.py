@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import gzip
+import io
 import re
 import zlib
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from pathlib import Path
 from typing import IO
 
 from clpc.data import DataError
+from clpc.io.budget import LINE_ENV, CountedReader, check_columns, limit, line_too_long
 from clpc.io.errors import is_number, show
 
 __all__ = [
@@ -29,6 +31,7 @@ __all__ = [
     "TextFormat",
     "decode_error",
     "is_content",
+    "open_binary",
     "open_text",
     "read_error",
     "sniff",
@@ -75,11 +78,19 @@ class TextFormat:
         return "whitespace" if self.delimiter is None else repr(self.delimiter)
 
 
+def open_binary(path: Path) -> IO[bytes]:
+    """Open a data file's bytes; a ``.gz`` is decompressed as a stream within the read limit.
+
+    Past ``CLPC_MAX_READ_BYTES`` (:mod:`clpc.io.budget`) a read raises a ``DataError``.
+    """
+    if path.name.lower().endswith(".gz"):
+        return io.BufferedReader(CountedReader(gzip.open(path, "rb"), show(path)), 1 << 16)
+    return open(path, "rb")
+
+
 def open_text(path: Path) -> IO[str]:
     """Open a text data file (gzip when it ends in ``.gz``; a UTF-8 BOM is dropped)."""
-    if path.name.lower().endswith(".gz"):
-        return gzip.open(path, "rt", encoding="utf-8-sig", newline=None)
-    return open(path, encoding="utf-8-sig", newline=None)
+    return io.TextIOWrapper(open_binary(path), encoding="utf-8-sig", newline=None)
 
 
 def is_content(line: str) -> bool:
@@ -170,9 +181,12 @@ def _first_lines(path: Path, skip_rows: int = 0) -> tuple[list[str], list[tuple[
     """
     comments: list[str] = []
     content: list[tuple[int, str]] = []
+    longest = limit(LINE_ENV)
     with open_text(path) as f:
         try:
-            for no, line in enumerate(f, 1):
+            for no, line in enumerate(iter(lambda: f.readline(longest + 1), ""), 1):
+                if len(line) > longest:
+                    raise line_too_long(show(path), no)
                 if no <= skip_rows:
                     continue
                 if is_content(line):
@@ -215,11 +229,15 @@ def sniff(path: Path, delimiter: str | None, header: bool | None, skip_rows: int
     Raises
     ------
     DataError
-        An empty file, a file that is not UTF-8 text, or an invalid ``delimiter``.
+        An empty file, a file that is not UTF-8 text, an invalid ``delimiter``, or a
+        file beyond a limit of :mod:`clpc.io.budget` (decompressed size, line length,
+        number of columns).
     """
     comments, content = _first_lines(path, skip_rows)
     try:
-        return _layout(comments, content, delimiter, header)
+        fmt = _layout(comments, content, delimiter, header)
+        check_columns(fmt.n_cols, show(path))
+        return fmt
     except csv.Error as exc:  # e.g. a field over the csv module's limit (131,072 characters)
         raise DataError(
             f"{show(path)} cannot be split into fields near line {content[0][0]} ({exc}); "

@@ -10,7 +10,6 @@ without any of these (the usual case) is passed on as it is.
 
 from __future__ import annotations
 
-import gzip
 import io
 import re
 import shutil
@@ -21,7 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from clpc.io.text_format import TextFormat
+from clpc.io.budget import LINE_ENV, limit, line_too_long
+from clpc.io.errors import show
+from clpc.io.text_format import TextFormat, open_binary
 
 __all__ = ["BLOCK_BYTES", "DataLines", "copy_stream"]
 
@@ -50,15 +51,16 @@ class DataLines(io.RawIOBase):
 
     def __init__(self, path: Path, fmt: TextFormat) -> None:
         super().__init__()
-        gz = path.name.lower().endswith(".gz")
-        self._raw: Any = gzip.open(path, "rb") if gz else open(path, "rb")
+        self._source = show(path)
+        self.longest = limit(LINE_ENV)
+        self._raw: Any = open_binary(path)
         head = self._raw.read(1 << 16)
         self._raw.seek(0)
         if b"\r" in head and b"\n" not in head:  # old Mac line ends: "\r" alone
             with self._raw:
                 self._raw = io.BytesIO(self._raw.read().replace(b"\r", b"\n"))
         for _ in range(fmt.data_line - 1):
-            self._raw.readline()
+            self._raw.readline(self.longest + 1)
         self._whitespace = fmt.delimiter is None
         self._first = fmt.data_line == 1
         self._next_line = fmt.data_line
@@ -81,13 +83,28 @@ class DataLines(io.RawIOBase):
         block = self._raw.read(BLOCK_BYTES)
         if not block:
             return False
-        block += self._raw.readline()
+        tail = self._raw.readline(self.longest + 1)
+        block += tail
+        if len(tail) > self.longest:
+            raise line_too_long(self._source, self._next_line + block.count(b"\n"))
+        self._check_lengths(block)
         if self._first:
             block, self._first = block.removeprefix(b"\xef\xbb\xbf"), False
         if not block.endswith(b"\n"):
             block += b"\n"
         self._pending, self._pos = self._clean(block), 0
         return True
+
+    def _check_lengths(self, block: bytes) -> None:
+        """Refuse a line of ``block`` longer than the line limit (``CLPC_MAX_LINE_BYTES``)."""
+        if len(block) <= self.longest:
+            return
+        ends = np.flatnonzero(np.frombuffer(block, dtype=np.uint8) == 10)
+        starts = np.concatenate([[-1], ends])
+        lengths = np.diff(np.concatenate([starts, [len(block)]])) - 1
+        if lengths.max() > self.longest:
+            line = self._next_line + int(np.argmax(lengths > self.longest))
+            raise line_too_long(self._source, line)
 
     def close(self) -> None:
         """Close the file."""

@@ -62,7 +62,9 @@ class _Reader:
         if not lines.peek():
             return lines, iter(())  # no data lines (pyarrow: "Empty CSV file")
         options = {
-            "read_options": csv.ReadOptions(column_names=names, block_size=BLOCK_BYTES),
+            "read_options": csv.ReadOptions(
+                column_names=names, block_size=max(BLOCK_BYTES, lines.longest + 2)
+            ),
             "parse_options": csv.ParseOptions(
                 delimiter=delimiter, quote_char='"', invalid_row_handler=ragged
             ),
@@ -73,7 +75,8 @@ class _Reader:
                 strings_can_be_null=True,
             ),
         }
-        if self.whole and not as_text:  # all at once: pyarrow parses the blocks in parallel
+        gz = self.path.name.lower().endswith(".gz")  # its size is unknown: block by block
+        if self.whole and not as_text and not gz:  # all at once: parsed in parallel
             return lines, iter(csv.read_csv(lines, **options).to_batches())
         return lines, csv.open_csv(lines, **options)
 
