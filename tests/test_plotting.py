@@ -175,6 +175,6 @@ def test_format_fit():
 
 def test_track_report(trace, tmp_path):
     files = report.write_track_report(tmp_path, trace, title="t", settings={"a": 1})
-    names = ["step.png", "bode.png", "pz.png", "trace.png", "report.html"]
+    names = ["quantities.png", "step.png", "bode.png", "pz.png", "trace.png", "report.html"]
     assert [f.name for f in files] == names
     assert all(f.stat().st_size > 0 for f in files)

@@ -1,8 +1,9 @@
 """The track report: figures and an HTML page of one CLPC trace (``clpc track``).
 
-Read top down: the result (converged or not, the model, warnings in a box), the model's
-fit on the measured data with residuals, its step and Bode responses, the trace, and last,
-folded, the latest updates and the settings.
+Read top down: the result (converged or not, the model, warnings in a box), the DC gain
+and dominant pole of every accepted update over time, the model's fit on the measured data
+with residuals, its step and Bode responses, the trace, and last, folded, the latest
+updates and the settings.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
+from clpc.plotting.track_quantities import MIN_SPAN_FRACTION, plot_track_quantities
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import model_summary, steady_state, trace_summary
@@ -80,6 +82,22 @@ def _result_table(trace: Trace, summary: Mapping[str, Any]) -> dict[str, Any]:
     return table
 
 
+def _quantities_section(trace: Trace, png: Path) -> Section:
+    unit = "samples" if trace.sample_time == 1.0 else "s"
+    return Section(
+        "Gain and poles over time",
+        text="DC gain B(1)/A(1) of each input and the dominant pole (largest |z|) of every "
+        "accepted cluster update; updates not accepted are left out (gaps). The pole is drawn "
+        "as natural frequency and damping of s = log(z)/dt, or as the time constant "
+        f"-1/Re(s) [{unit}] when it is real in every accepted update. The trace holds no "
+        "per-update parameter uncertainty, so no uncertainty band is drawn. Axes have no "
+        "offset; y-limits hold the 1st to 99th percentile (outliers are clipped) and span at "
+        f"least {MIN_SPAN_FRACTION:.0%} of the median level, so noise on a steady value "
+        "stays small.",
+        images=[(png, "DC gain and dominant pole over time")],
+    )
+
+
 def write_track_report(
     out_dir: str | PathLike[str],
     trace: Trace,
@@ -98,7 +116,8 @@ def write_track_report(
     Parameters
     ----------
     out_dir : str or path-like
-        Folder (created) for ``trace.png``, the figures of the :func:`steady_state` model
+        Folder (created) for ``quantities.png`` (DC gain and dominant pole over time, the
+        first figure), ``trace.png``, the figures of the :func:`steady_state` model
         (when there is one: ``step.png``, ``bode.png``, ``pz.png`` and, with ``data``,
         ``fit.png`` and ``data.png``) and ``report.html``.
     trace : Trace
@@ -146,9 +165,12 @@ def write_track_report(
         table=_result_table(trace, summary),
     )
     sections = [result]
-    files: list[Path] = []
+    quantities_png = out / "quantities.png"
+    plot_track_quantities(trace, quantities_png)
+    files: list[Path] = [quantities_png]
+    sections.append(_quantities_section(trace, quantities_png))
     if model is not None:
-        more, files = model_sections(
+        more, model_files = model_sections(
             model,
             out,
             data=data,
@@ -158,6 +180,7 @@ def write_track_report(
         )
         more[0].heading = f"Model: {source}"
         sections += more
+        files += model_files
     else:
         result.text = "The figure of the trace below shows why no estimate was accepted."
     if summary.get("advice"):
