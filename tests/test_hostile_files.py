@@ -1,4 +1,9 @@
-"""Hostile files through ``clpc identify``: bounded readers, one-line errors (issue 28, item 2)."""
+"""Hostile files through ``clpc identify`` and ``clpc track``: bounded readers, one-line errors.
+
+Issue 28, item 2. Every hostile file goes through both commands (the ``command`` fixture):
+exit 1, one ``Error:`` line naming the file, no traceback; ``track`` leaves nothing in its
+``--out`` folder that claims a complete run.
+"""
 
 from __future__ import annotations
 
@@ -11,22 +16,45 @@ import pytest
 from click.testing import CliRunner
 
 from clpc.cli import cli
+from clpc.core.output_folder import LOCK_NAME
 from clpc.data import DataError
 from clpc.io import iter_table_chunks, read_table
 from clpc.io.budget import COLUMNS_ENV, LINE_ENV, MAX_COLUMNS, READ_ENV
 
+#: the command a test's hostile files go through (see the ``command`` fixture)
+_COMMAND = {"name": "identify"}
+
+
+@pytest.fixture(params=["identify", "track"], autouse=True)
+def command(request):
+    """Run each test with its hostile files given to ``clpc identify``, then ``clpc track``."""
+    _COMMAND["name"] = request.param
+    yield request.param
+    _COMMAND["name"] = "identify"
+
 
 def _identify(path, *columns: str, named: bool = True) -> tuple[str, float]:
-    """``clpc identify`` of a hostile file: exit 1, one ``Error:`` line; its text and time."""
+    """The command of a hostile file: exit 1, one ``Error:`` line; its text and time.
+
+    For ``clpc track`` the ``--out`` folder must not claim a complete run: it holds at most
+    the lock file (no run record, report, trace, figure or staging folder).
+    """
     cols = columns or ("u", "y")
+    args = [_COMMAND["name"], str(path), "-u", cols[0], "-y", cols[1]]
+    out = path.parent / f"out-{path.name}"
+    if _COMMAND["name"] == "track":
+        args += ["--out", str(out)]
     start = time.perf_counter()
-    res = CliRunner().invoke(cli, ["identify", str(path), "-u", cols[0], "-y", cols[1]])
+    res = CliRunner().invoke(cli, args)
     took = time.perf_counter() - start
     assert res.exit_code == 1, res.output
     assert isinstance(res.exception, SystemExit), repr(res.exception)
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error: "), res.output
     assert "Traceback" not in res.output and (path.name in lines[0] or not named)
+    if out.exists():
+        left = sorted(p.name for p in out.iterdir())
+        assert set(left) <= {LOCK_NAME}, left  # no run record, trace, figure or staging
     return lines[0], took
 
 

@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -124,3 +125,69 @@ def test_column_index_past_the_header_is_one_line():
     res = CliRunner().invoke(cli, ["stream", "-u", "0", "-y", "2"], input="u,y\n1,2\n3,4\n")
     assert res.exit_code == 2 and "Traceback" not in res.output
     assert "column index 2 is past the header's 2 columns" in res.output
+
+
+def _piped(text: bytes, env: dict[str, str], *args: str) -> subprocess.CompletedProcess:
+    """``clpc stream`` in a real process, ``text`` piped to its standard input."""
+    full = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), **env)
+    return subprocess.run(
+        [sys.executable, "-m", "clpc", "stream", *ARGS, *args],
+        input=text,
+        capture_output=True,
+        env=full,
+        timeout=120,
+    )
+
+
+@posix
+@pytest.mark.parametrize("on_error", ["skip", "stop"])
+def test_a_line_over_the_line_limit_ends_the_stream_with_one_line(tmp_path, on_error):
+    """Issue 28: a line is bounded by CLPC_MAX_LINE_BYTES; one over it is refused, not skipped."""
+    lines, u, y = _lines(600)
+    a, b = u[399].item(), y[399].item()
+    lines[399] = f"{a!r}," + " " * (1000 - len(f"{a!r},{b!r}")) + f"{b!r}\n"  # at the limit
+    lines[450] = "1," + "0" * 999 + "\n"  # 1,001 bytes: just over
+    state = tmp_path / "s.json"
+    res = _piped(
+        "".join(lines).encode(),
+        {"CLPC_MAX_LINE_BYTES": "1000"},
+        "--on-error",
+        on_error,
+        "--state",
+        str(state),
+    )
+    err = res.stderr.decode().strip().splitlines()
+    assert res.returncode == 1 and len(err) == 1, err
+    assert err[0].startswith("Error: standard input line 451 is longer than the line limit")
+    assert "1,000 bytes" in err[0] and "CLPC_MAX_LINE_BYTES" in err[0]
+    assert "Traceback" not in res.stderr.decode()
+    # the 450 lines before it, the one at the limit included, were used and saved
+    got = [json.loads(x) for x in res.stdout.splitlines()]
+    ref = clpc.CLPC(order=2, window_size=51, cluster_size=7).run(u[:450], y[:450])
+    assert [g["index"] for g in got] == ref.index.tolist()
+    np.testing.assert_array_equal(np.array([g["theta"] for g in got]), ref.theta)
+    assert clpc.CLPC.load(str(state)).n_samples == 450
+
+
+@posix
+def test_a_64_mib_line_is_refused_at_the_default_limit_quickly():
+    """Formerly the whole line was held and re-copied per block: 24.7 s for 64 MiB."""
+    lines, _, _ = _lines(100)
+    text = "".join(lines[:60]).encode() + b"1," + b"0" * (64 << 20) + b"\n"
+    start = time.perf_counter()
+    res = _piped(text, {})
+    took = time.perf_counter() - start
+    err = res.stderr.decode().strip().splitlines()
+    assert res.returncode == 1 and len(err) == 1, err
+    assert "standard input line 61 is longer than the line limit of 4,194,304 bytes" in err[0]
+    assert took < 15, took
+
+
+def test_a_line_just_over_a_lowered_limit_in_one_read(monkeypatch):
+    """The limit also holds when the long line arrives within one block (no pipe)."""
+    monkeypatch.setenv("CLPC_MAX_LINE_BYTES", "20")
+    res = CliRunner().invoke(cli, ["stream", "--dt", "1"], input="1,2\n# " + "x" * 19 + "\n")
+    assert res.exit_code == 1 and "Traceback" not in res.output
+    assert "line 2 is longer than the line limit of 20 bytes" in res.output
+    res = CliRunner().invoke(cli, ["stream", "--dt", "1"], input="1,2\n# " + "x" * 18 + "\n")
+    assert res.exit_code == 0 and "line limit" not in res.output  # 20 bytes: allowed

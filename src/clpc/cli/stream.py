@@ -84,7 +84,9 @@ def stream(settings: StreamSettings, state_file: str | None) -> None:
     skip) or ends the run with exit code 1 (--on-error stop); so is a last line without
     a newline (cut short). With --time, a gap (dropped samples) is reported once and the
     grid re-anchored; a stamp that goes back or lands between grid points is a malformed
-    line; the unit comes from the column's name (t_ms is ms) or --time-unit.
+    line; the unit comes from the column's name (t_ms is ms) or --time-unit. A line
+    longer than CLPC_MAX_LINE_BYTES bytes (default 4 MiB) ends the run with exit code 1
+    (the state is saved first), whatever --on-error says.
 
     \b
     Exit codes:

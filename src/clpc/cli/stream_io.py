@@ -16,6 +16,7 @@ from types import FrameType, TracebackType
 
 import click
 
+from clpc.io.budget import LINE_ENV, limit, line_too_long
 from clpc.workflows.stream_lines import CutLine
 
 __all__ = ["EXIT_CLOSED_PIPE", "STOP_SIGNALS", "Interrupts", "Stopped", "stdin_batches"]
@@ -90,7 +91,11 @@ def stdin_batches(stops: Interrupts) -> Iterator[list[str]]:
 
     ``read1`` returns what the pipe holds (at most 64 KiB) without waiting for more, so a
     slow producer gets its updates at once and a fast one is processed in vectorised batches.
-    A last line without a newline comes as a :class:`CutLine`.
+    A last line without a newline comes as a :class:`CutLine`. One line may hold at most
+    ``CLPC_MAX_LINE_BYTES`` bytes (:mod:`clpc.io.budget`, 4 MiB by default; its newline not
+    counted): the unfinished line is kept in a growing buffer that is refused as soon as it
+    passes the limit, so a longer line is never held whole and costs time linear in its
+    length. The lines before it are yielded first.
 
     Parameters
     ----------
@@ -101,20 +106,30 @@ def stdin_batches(stops: Interrupts) -> Iterator[list[str]]:
     ------
     list of str
         Lines without their newlines.
+
+    Raises
+    ------
+    DataError
+        A line longer than the line limit; the message names its line number, the limit
+        and the variable that raises it.
+    click.ClickException
+        Standard input is closed.
     """
     if sys.stdin is None:
         raise click.ClickException(
             "standard input is closed; pipe the samples in (e.g. my_daq | clpc stream ...)."
         )
+    longest = limit(LINE_ENV)
     raw = getattr(sys.stdin, "buffer", None)
     text_only = raw is None or not hasattr(raw, "read1")
-    rest = b""
+    rest = bytearray()  # the start of a line whose newline has not arrived yet
+    done = 0  # lines yielded so far
     while True:
         stops.check()
         stops.waiting = True
         try:
             if text_only:
-                block = sys.stdin.readline().encode("utf-8", errors="replace")
+                block = sys.stdin.readline(longest + 1).encode("utf-8", errors="replace")
             else:
                 assert raw is not None
                 block = raw.read1(1 << 16)
@@ -124,9 +139,22 @@ def stdin_batches(stops: Interrupts) -> Iterator[list[str]]:
             stops.waiting = False
         if not block:
             break
-        lines = (rest + block).split(b"\n")
-        rest = lines.pop()
-        if lines:
-            yield [line.decode("utf-8", errors="replace") for line in lines]
+        end = block.rfind(b"\n")
+        if end < 0:
+            rest += block  # amortised: no copy of the whole line per block
+            if len(rest) > longest:
+                raise line_too_long("standard input", done + 1)
+            continue
+        lines = (rest + block[:end]).split(b"\n")
+        rest = bytearray(block[end + 1 :])
+        long = next((i for i, line in enumerate(lines) if len(line) > longest), None)
+        if long is not None:
+            if long:
+                yield [line.decode("utf-8", errors="replace") for line in lines[:long]]
+            raise line_too_long("standard input", done + long + 1)
+        done += len(lines)
+        yield [line.decode("utf-8", errors="replace") for line in lines]
+        if len(rest) > longest:
+            raise line_too_long("standard input", done + 1)
     if rest:
         yield [CutLine(rest.decode("utf-8", errors="replace"))]
