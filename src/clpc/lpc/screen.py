@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from clpc.data import IOData
+from clpc.lpc import heldout
 from clpc.model.structure import Structure
 
 __all__ = ["PARSIMONY", "Screen", "screen"]
@@ -202,7 +203,6 @@ class _LagSet:
         drive = mat[:, self.na : -1] @ coef[:, self.na :].T + k  # (rows, n_structures)
         past = y[self.start - 1 :: -1][: self.na]  # y(start-1), y(start-2), ...
         target = y[self.start :]
-        spread = float(np.linalg.norm(target - target.mean()))
         out = np.empty(coef.shape[0])
         with np.errstate(all="ignore"):
             for s, na in enumerate(self.orders):
@@ -210,8 +210,5 @@ class _LagSet:
                 # lfilter's transposed direct-form state for the measured past outputs
                 zi = np.array([den[m + 1 :] @ past[: na - m] for m in range(na)])
                 sim = signal.lfilter([1.0], den, drive[:, s], zi=-zi)[0]
-                err = float(np.linalg.norm(target - sim))
-                out[s] = 100.0 * (1.0 - err / spread) if math.isfinite(err) else -math.inf
-        if not spread > 0:
-            out[:] = -math.inf
+                out[s] = heldout.fit_percent(target, sim)
         return out
