@@ -34,6 +34,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("clpc.io", "clpc.datasets"),
     ("clpc.plotting", "clpc.report"),
     ("clpc.workflows",),
+    ("clpc.distributed",),  # fleets and long records on Dask, over the workflows
     ("clpc.cli", "clpc.__main__"),
     ("clpc",),  # the package facade re-exports everything
 ]
