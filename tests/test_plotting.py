@@ -178,3 +178,17 @@ def test_track_report(trace, tmp_path):
     names = ["quantities.png", "step.png", "bode.png", "pz.png", "trace.png", "report.html"]
     assert [f.name for f in files] == names
     assert all(f.stat().st_size > 0 for f in files)
+
+
+def test_figures_show_in_a_notebook_without_pyplot(model):
+    # a figure returned to a notebook cell renders through its own _repr_png_ (IPython's
+    # display hook for matplotlib is installed only by %matplotlib or a pyplot import)
+    import io
+
+    from matplotlib.image import imread
+
+    fig = plotting.plot_step(model)
+    png = fig._repr_png_()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = (fig.get_size_inches() * fig.dpi).round().astype(int)
+    assert imread(io.BytesIO(png)).shape[:2] == (height, width)

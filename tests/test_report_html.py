@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import os
 import shutil
 import subprocess
 from html.parser import HTMLParser
@@ -203,11 +204,16 @@ def test_report_without_dt_is_labelled_in_samples(tmp_path):
 def render_in_chromium(page: Path, tmp_path: Path, size: tuple[int, int] = (1000, 1400)):
     """Render ``page`` in headless Chromium: (the DOM it built, the screenshot's pixels).
 
-    Skips the calling test, with the reason, where no chromium is installed.
+    Skips the calling test, with the reason, where no chromium is installed, except in CI
+    (the environment variable ``CI`` set, as ``.ci/run`` does after installing Chromium):
+    there a missing browser fails the test, so a rendering check is never skipped silently.
     """
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
     if browser is None:
-        pytest.skip("no chromium on PATH: the headless rendering check needs a real browser")
+        reason = "no chromium on PATH: the headless rendering check needs a real browser"
+        if os.environ.get("CI"):
+            pytest.fail(reason + " (CI: .ci/run installs it from the system packages)")
+        pytest.skip(reason)
     shot = tmp_path / "shot.png"
     cmd = [
         browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",

@@ -108,10 +108,11 @@ def new_grid(n_rows: int, n_cols: int, margins: Margins, *, height: float, width
 def _figure(size: tuple[float, float], *, constrained: bool) -> Any:
     try:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
+
+        from clpc.core.notebook_figure import NotebookFigure
     except ImportError:  # pragma: no cover - depends on the environment
         raise ImportError(INSTALL_HINT) from None
-    fig = Figure(figsize=size, layout="constrained" if constrained else None)
+    fig = NotebookFigure(figsize=size, layout="constrained" if constrained else None)
     FigureCanvasAgg(fig)
     return fig
 

@@ -44,7 +44,7 @@ def plot_multimodel(
     str
         The file name written.
     """
-    from matplotlib.figure import Figure
+    from clpc.core.notebook_figure import NotebookFigure
 
     psi = _grid(mm)
     lin = [mm.linearize(p) for p in psi]
@@ -53,7 +53,7 @@ def plot_multimodel(
     freqs = np.array(
         [np.sort(np.abs(np.log(m.poles().astype(complex))) / (2 * np.pi * dt))[:2] for m in lin]
     )
-    fig = Figure(figsize=(6.4, 7.2), layout="constrained")
+    fig = NotebookFigure(figsize=(6.4, 7.2), layout="constrained")
     ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
     ax1.plot(psi, gains, "C0", label="multi-model (frozen validity)")
     own = [float(m.dc_gain()[0, 0]) for m in mm.local_models]
