@@ -11,9 +11,12 @@ from scipy import signal
 import clpc
 from clpc import report
 from clpc.plotting.track_quantities import (
+    BAND_PERCENTILES,
+    BAND_WINDOWS,
     MIN_SPAN_FRACTION,
     plot_track_quantities,
     robust_limits,
+    spread_band,
     track_quantities,
 )
 
@@ -101,4 +104,28 @@ def test_track_report_shows_the_gain_figure_first(switched, tmp_path):
     html = files[-1].read_text()
     alts = re.findall(r'<img alt="([^"]*)"', html)
     assert alts[0] == "DC gain and dominant pole over time", alts
-    assert "no uncertainty band" in html
+    assert "shaded band" in html and "lower bound" in html
+
+
+def test_band_is_the_spread_of_the_neighbouring_windows(switched):
+    q = track_quantities(switched)
+    t, gain = q["time"], q["gain"][:, 0]
+    window = float(np.max(switched.rows)) * DT
+    lo, hi = spread_band(t, gain, BAND_WINDOWS * window)
+    # independent recomputation at a few updates: percentiles of the accepted values whose
+    # update lies within the same count of updates on each side
+    step = float(np.median(np.diff(t)))
+    k = int(BAND_WINDOWS * window // step)
+    for i in np.flatnonzero(np.isfinite(gain))[5::37]:
+        near = gain[max(0, i - k) : i + k + 1]
+        near = near[np.isfinite(near)]
+        np.testing.assert_allclose(
+            [lo[i], hi[i]], np.percentile(near, BAND_PERCENTILES), rtol=1e-12
+        )
+    # drawn as the first panel's shaded area, and wider where the gain doubles
+    fig = plot_track_quantities(switched)
+    assert len(fig.axes[0].collections) >= 1
+    width = hi - lo
+    change = np.abs(t - t[-1] / 2) < window
+    steady = (t > 0.2 * t[-1]) & (t < 0.35 * t[-1])
+    assert np.nanmedian(width[change]) > 3 * np.nanmedian(width[steady])

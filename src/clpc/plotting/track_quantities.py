@@ -5,7 +5,10 @@ update, the DC gain ``G(1) = B(1) / A(1)`` of each input (the monic ``den``/``nu
 held ``theta``) and the dominant pole (largest ``|z|``) as natural frequency and damping
 (or as a time constant when the dominant pole is real in every accepted update). Axes have
 no offset, and y-limits come from percentiles so that a few outliers or tiny noise do not
-fill the panel (:func:`robust_limits`).
+fill the panel (:func:`robust_limits`). A shaded band around each curve shows how much the
+estimates of neighbouring windows disagree (:func:`spread_band`): the trace holds no
+per-window parameter covariance, and this spread is what the record itself says about how
+well each window fixes the quantity.
 """
 
 from __future__ import annotations
@@ -25,7 +28,15 @@ from clpc.core.figure import (
     time_label,
 )
 
-__all__ = ["MIN_SPAN_FRACTION", "plot_track_quantities", "robust_limits", "track_quantities"]
+__all__ = [
+    "BAND_PERCENTILES",
+    "BAND_WINDOWS",
+    "MIN_SPAN_FRACTION",
+    "plot_track_quantities",
+    "robust_limits",
+    "spread_band",
+    "track_quantities",
+]
 
 #: a panel's y-span is never smaller than this fraction of the level (median |value|), so
 #: noise around a constant level is drawn as the small wobble it is
@@ -34,7 +45,12 @@ MIN_SPAN_FRACTION = 0.2
 #: percentiles of the accepted values the y-limits hold (outliers beyond are clipped)
 PERCENTILES = (1.0, 99.0)
 
-_MARGINS = Margins(left=0.95, right=0.25, top=0.62, bottom=0.55, row_gap=0.66, col_gap=1.0)
+#: the band around a curve: these percentiles (about +-1 sigma of a normal spread) of the
+#: accepted values of the updates within BAND_WINDOWS window lengths before and after
+BAND_PERCENTILES = (16.0, 84.0)
+BAND_WINDOWS = 2.0
+
+_MARGINS = Margins(left=0.95, right=0.25, top=0.85, bottom=0.55, row_gap=0.66, col_gap=1.0)
 
 
 def _dominant(den: np.ndarray) -> np.ndarray:
@@ -127,7 +143,48 @@ def robust_limits(values: Any, min_fraction: float = MIN_SPAN_FRACTION) -> tuple
     return mid - 0.6 * span, mid + 0.6 * span
 
 
-def _panel(ax: Any, t: np.ndarray, y: np.ndarray, color: str, label: str | None = None):
+def spread_band(time: Any, values: Any, half_span: float) -> tuple[np.ndarray, np.ndarray]:
+    """Percentiles of the finite values of the updates within ``half_span`` of each.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Time of each update [s, or samples] (increasing, evenly spaced: one update every
+        ``cluster_size`` samples).
+    values : array_like, shape (n,)
+        One quantity per update; NaN where no estimate was accepted (ignored).
+    half_span : float
+        Half-width of the neighbourhood, in the unit of ``time``;
+        :func:`plot_track_quantities` uses :data:`BAND_WINDOWS` window lengths.
+
+    Returns
+    -------
+    (ndarray, ndarray), each shape (n,)
+        The :data:`BAND_PERCENTILES` of the neighbourhood; NaN where the update itself has
+        no value or fewer than 3 neighbours do. Neighbouring windows overlap, so their
+        estimates are correlated and the band is a lower bound on the uncertainty of one
+        window's estimate; a change of the plant widens it around the change.
+    """
+    import pandas as pd
+
+    t = np.asarray(time, dtype=float)
+    v = np.asarray(values, dtype=float)
+    if v.size < 2:
+        return np.full(v.shape, np.nan), np.full(v.shape, np.nan)
+    step = float(np.median(np.diff(t)))
+    count = 2 * int(half_span // step) + 1 if step > 0 else 1
+    rolling = pd.Series(v).rolling(count, center=True, min_periods=3)
+    lo, hi = (np.array(rolling.quantile(p / 100.0), dtype=float) for p in BAND_PERCENTILES)
+    missing = ~np.isfinite(v)
+    lo[missing], hi[missing] = np.nan, np.nan
+    return lo, hi
+
+
+def _panel(
+    ax: Any, t: np.ndarray, y: np.ndarray, color: str, half_span: float, label: str | None = None
+) -> None:
+    lo, hi = spread_band(t, y, half_span)
+    ax.fill_between(t, lo, hi, color=color, alpha=0.25, lw=0)
     draw_signal(ax, t, y, color=color, label=label, marker=".", ms=2, lw=0.8)
 
 
@@ -167,8 +224,10 @@ def plot_track_quantities(
 
     Notes
     -----
-    Updates not accepted are omitted (gaps). The trace holds no per-update parameter
-    uncertainty, so no band is drawn. Y-limits: :func:`robust_limits`; no offset axes.
+    Updates not accepted are omitted (gaps). The band around each curve is the spread of
+    the neighbouring windows' estimates (:func:`spread_band`, :data:`BAND_WINDOWS` window
+    lengths each side); the trace holds no per-update parameter covariance. Y-limits:
+    :func:`robust_limits`; no offset axes.
     """
     n_eq = trace.n_equations
     per_eq = [track_quantities(trace, e) for e in range(n_eq)]
@@ -178,6 +237,8 @@ def plot_track_quantities(
     xlabel = time_label(trace.sample_time)
     unit_t = "samples" if trace.sample_time == 1.0 else "s"
     unit_w = "rad/sample" if trace.sample_time == 1.0 else "rad/s"
+    # a window's length [s, or samples]: its most rows, at the appraiser's (decimated) rate
+    half_span = BAND_WINDOWS * float(np.max(trace.rows, initial=1)) * float(trace.sample_time)
     row = 0
     for e, q in enumerate(per_eq):
         name = trace.output_names[e] if e < len(trace.output_names) else f"y{e}"
@@ -186,22 +247,27 @@ def plot_track_quantities(
         inputs = [i for i in range(q["gain"].shape[1]) if np.any(q["gain"][:, i] != 0)]
         for k, i in enumerate(inputs):
             lab = trace.input_names[i] if i < len(trace.input_names) else f"u{i}"
-            _panel(ax, t, q["gain"][:, i], f"C{k}" if k else COLORS["theta"], f"{lab} → {name}")
+            color = f"C{k}" if k else COLORS["theta"]
+            _panel(ax, t, q["gain"][:, i], color, half_span, f"{lab} → {name}")
         _finish(ax, q["gain"][:, inputs], f"DC gain ({name})", xlabel, t)
         place_legend(ax)
         row += 1
         if real[e]:
             ax = fig.add_subplot(grid[row, 0])
-            _panel(ax, t, q["tau"], COLORS["model"])
+            _panel(ax, t, q["tau"], COLORS["model"], half_span)
             _finish(ax, q["tau"], f"time constant [{unit_t}]", xlabel, t)
             row += 1
             continue
         for key, ylabel in (("wn", f"ω_n [{unit_w}]"), ("zeta", "damping ζ [-]")):
             ax = fig.add_subplot(grid[row, 0])
-            _panel(ax, t, q[key], COLORS["model"])
+            _panel(ax, t, q[key], COLORS["model"], half_span)
             _finish(ax, q[key], ylabel, xlabel, t)
             row += 1
-    heading = title or f"DC gain and dominant pole of {len(trace)} updates (accepted only)"
-    fig.suptitle(heading, y=1.0 - 0.1 / fig.get_figheight(), va="top")
+    heading = title or (
+        f"DC gain and dominant pole of {len(trace)} updates (accepted only)\nband: "
+        f"{BAND_PERCENTILES[0]:g}-{BAND_PERCENTILES[1]:g}th percentile of the updates "
+        f"within ±{BAND_WINDOWS:g} window lengths"
+    )
+    fig.suptitle(heading, y=1.0 - 0.08 / fig.get_figheight(), va="top", fontsize="medium")
     save_figure(fig, path)
     return fig

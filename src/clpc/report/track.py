@@ -18,7 +18,12 @@ from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
 from clpc.plotting import plot_trace
-from clpc.plotting.track_quantities import MIN_SPAN_FRACTION, plot_track_quantities
+from clpc.plotting.track_quantities import (
+    BAND_PERCENTILES,
+    BAND_WINDOWS,
+    MIN_SPAN_FRACTION,
+    plot_track_quantities,
+)
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import model_summary, steady_state, trace_summary
@@ -89,8 +94,12 @@ def _quantities_section(trace: Trace, png: Path) -> Section:
         text="DC gain B(1)/A(1) of each input and the dominant pole (largest |z|) of every "
         "accepted cluster update; updates not accepted are left out (gaps). The pole is drawn "
         "as natural frequency and damping of s = log(z)/dt, or as the time constant "
-        f"-1/Re(s) [{unit}] when it is real in every accepted update. The trace holds no "
-        "per-update parameter uncertainty, so no uncertainty band is drawn. Axes have no "
+        f"-1/Re(s) [{unit}] when it is real in every accepted update. The shaded band is the "
+        f"{BAND_PERCENTILES[0]:g}th to {BAND_PERCENTILES[1]:g}th percentile of the estimates "
+        f"of the updates within {BAND_WINDOWS:g} window lengths before and after (the trace "
+        "holds no per-window parameter covariance; neighbouring windows overlap, so the band "
+        "is a lower bound on one window's uncertainty, and it widens where the plant "
+        "changes). Axes have no "
         "offset; y-limits hold the 1st to 99th percentile (outliers are clipped) and span at "
         f"least {MIN_SPAN_FRACTION:.0%} of the median level, so noise on a steady value "
         "stays small.",
