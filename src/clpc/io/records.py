@@ -25,6 +25,7 @@ from clpc.data.timebase import (
 from clpc.data.timebase import time_unit as time_unit_of
 from clpc.io.errors import show
 from clpc.io.loading import read_table
+from clpc.io.roles import check_column_roles
 from clpc.io.table import ColumnKey, Columns, PathLike, Table
 
 __all__ = ["load_iodata"]
@@ -91,16 +92,18 @@ def load_iodata(
     Raises
     ------
     DataError
-        Any problem of :func:`read_table`; a time column that is not increasing or not
-        uniformly sampled (the message names the first offending line/row and what was
-        measured); a ``dt`` that disagrees with the time column; ``resample`` without a
-        time column.
+        Any problem of :func:`read_table`; a column in two roles or a time-stamp column
+        used as a signal (:func:`clpc.io.roles.check_column_roles`); a time column that
+        is not increasing or not uniformly sampled (the message names the first offending
+        line/row and what was measured); a ``dt`` that disagrees with the time column;
+        ``resample`` without a time column.
     """
     in_keys = _keys(inputs, "inputs")
     out_keys = _keys(outputs, "outputs")
     keys = in_keys + out_keys + ([] if time_column is None else [time_column])
     table = read_table(path, columns=keys, delimiter=delimiter, header=header, skip_rows=skip_rows)
     n_in, n_out = len(in_keys), len(out_keys)
+    check_column_roles(path, table.names, n_in, n_out)
     values = table.data[:, : n_in + n_out]
     if resample and time_column is None:
         raise DataError("resample needs a time column (time_column=, --time COL).")

@@ -161,6 +161,20 @@ class LineReader:
         self.wanted = wanted
         if settings.fmt == "csv" and wanted and all(w.isdigit() for w in wanted):
             self.use = [int(w) for w in wanted]
+        self._check_roles(list(self.use) if self.use is not None else list(wanted))
+
+    def _check_roles(self, columns: list[Any]) -> None:
+        """A SettingsError when one column (name or index) is given two roles."""
+        roles = ["input"] * self.n_in + ["output"] * self.n_out + ["time column"]
+        seen: dict[Any, str] = {}
+        for column, role in zip(columns, roles, strict=False):
+            if column in seen:
+                shown = self.names[column] if isinstance(column, int) and self.names else column
+                raise SettingsError(
+                    f"column {shown!r} is selected as {seen[column]} and as {role}; each "
+                    f"column can have one role. Name another column for the {role}."
+                )
+            seen[column] = role
 
     @property
     def time_name(self) -> str:
@@ -227,6 +241,7 @@ class LineReader:
                 f"{len(names) - 1}."
             )
         self.names = names
+        self._check_roles(list(self.use or ()))
         self.notes.append(f"line {self.no}: header (column names): {', '.join(names)}")
         return True
 

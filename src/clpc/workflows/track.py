@@ -21,6 +21,7 @@ from clpc.core.output_folder import OutputFolder
 from clpc.data import DataError, IOData
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
+from clpc.io.roles import check_column_roles
 from clpc.io.text_format import sniff
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary, write_track_report
@@ -291,6 +292,7 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                         "use a larger --chunk-rows or --dt."
                     )
             if run is None:
+                check_column_roles(record.file, names, n_in, n_out)
                 data_dt = clock.dt if clock is not None else record.dt
                 kept = ThinnedTrace(settings.figure_updates)
                 appraiser = settings.appraiser.build(data_dt)
