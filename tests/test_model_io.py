@@ -239,3 +239,23 @@ def test_save_into_missing_directory(tmp_path, fitted):
     model, _ = fitted["siso"]
     with pytest.raises(FileNotFoundError, match=r"directory '.*nowhere' does not exist"):
         save_model(model, tmp_path / "nowhere" / "m.json")
+
+
+@pytest.mark.parametrize("null", [None, [None]])
+def test_a_model_file_with_null_statistics_loads_prints_and_judges(tmp_path, null):
+    # issue 28 item 7: null info fields (a file edited or written by another tool) are
+    # statistics the file does not have, not a crash in repr, summary or the verdict
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(2000)
+    y = clpc.simulate_arx([1.0, -0.8], [0.0, 0.5], u) + 0.01 * rng.standard_normal(2000)
+    path = tmp_path / "m.json"
+    clpc.save_model(clpc.LPC(order=1).fit(u, y), path)
+    doc = json.loads(path.read_text())
+    assert len(doc["info"]) > 5
+    doc["info"] = {key: null for key in doc["info"]}
+    path.write_text(json.dumps(doc))
+    model = clpc.load_model(path)
+    assert model.info == {}
+    assert "den(z)" in repr(model) and "DC gain" in model.summary()
+    assert "<table" in model._repr_html_()
+    assert "no fit statistics" in str(clpc.fit_verdict(model))

@@ -71,3 +71,21 @@ def test_a_failed_background_write_is_raised_by_the_next_write_and_leaves_no_fil
         w.write(parts[2])  # the writer is spent: the same error, nothing written
     w.close()  # discarded: nothing more to raise
     assert calls == [len(parts[0])] and list(tmp_path.iterdir()) == []
+
+
+def test_csv_trace_header_quotes_channel_names_with_commas(tmp_path):
+    # issue 28 item 7: a name with a comma or a quote stays one column for any csv reader
+    import pandas as pd
+
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(600)
+    y = np.column_stack([np.convolve(u, [0, 0.5])[:600], np.convolve(u, [0, 0.3])[:600]])
+    data = clpc.IOData(u, y, dt=0.01, input_names=["in,put"], output_names=["out,1", 'out"2'])
+    trace = clpc.CLPC(order=1, window_size=101, cluster_size=10).run(data)
+    path = tmp_path / "trace.csv"
+    with TraceWriter(path) as writer:
+        writer.write(trace)
+    frame = pd.read_csv(path)
+    names, _ = trace_columns(trace)
+    assert list(frame.columns) == names and "out,1:a0" in names and 'out"2:a0' in names
+    np.testing.assert_array_equal(frame["out,1:a0"].to_numpy(), trace.theta[:, 0, 0])

@@ -9,6 +9,8 @@ for figures and summaries (every update until the cap, then every 2nd, 4th, ... 
 from __future__ import annotations
 
 import contextlib
+import csv
+import io
 import os
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -107,6 +109,17 @@ def _arrow() -> Any:
     return pa
 
 
+def _csv_header(names: list[str]) -> str:
+    """The header line of a csv trace: names quoted as RFC 4180 says where they need it.
+
+    A channel name with a comma, quote or line break (``"out,1:a0"``) is quoted, so that
+    any csv reader finds one column per name.
+    """
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerow(names)
+    return buffer.getvalue()
+
+
 class TraceWriter:
     """Append trace parts to a CSV or Parquet file (``trace_columns`` layout).
 
@@ -182,7 +195,7 @@ class TraceWriter:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._target = atomic_path(self.path)
         tmp = self._target.__enter__()
-        header = (",".join(names) + "\n").encode()
+        header = _csv_header(names).encode()
         if self.suffix == ".csv":
             self._pa = _arrow()
             if self._pa is not None:

@@ -26,6 +26,13 @@ _MAX_VALUE = 1e150
 _MAX_NUM_COEFFICIENTS = 10_000_000
 
 
+def _is_null(value: Any) -> bool:
+    """JSON ``null``, or a list whose every item is null."""
+    if isinstance(value, list):
+        return bool(value) and all(item is None for item in value)
+    return value is None
+
+
 def _info_from_json(value: Any) -> Any:
     """Inverse of the writer's JSON conversion: numeric lists become arrays again."""
     if isinstance(value, dict):
@@ -149,6 +156,9 @@ def model_from_dict(d: dict[str, Any], *, source: str | None = None) -> LinearMo
         raise check.fail("info is nested too deeply; it is not one clpc wrote.") from None
     except ValueError as exc:
         raise check.fail(f"info holds {exc}; it is not one clpc wrote.") from None
+    # a null statistic (or a list of nulls) is one the file does not have: left out, so that
+    # every reader of ``info`` sees it missing rather than meeting None where a number goes
+    info = {key: value for key, value in info.items() if not _is_null(value)}
     model = LinearModel(
         theta=theta,
         structure=structure,
