@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -222,3 +223,31 @@ def test_bad_arguments_are_refused():
         clpc.MultiModel(estimator="svm")
     with pytest.raises(ValueError, match="not fitted"):
         clpc.MultiModel().simulate(np.ones(10))
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (lambda d: d.pop("structure"), "no 'structure' field"),
+        (lambda d: d["local_models"][0].pop("theta"), "local model 0 has no 'theta'"),
+        (lambda d: d["local_models"][1]["theta"].__setitem__(0, "x"), "must hold numbers"),
+        (lambda d: d["local_models"][1]["theta"].__setitem__(0, float("nan")), "must be finite"),
+        (lambda d: d["centres"].__setitem__(0, float("inf")), "centres must be finite"),
+        (lambda d: d["widths"].__setitem__(0, -1.0), "widths must be positive"),
+        (lambda d: d.__setitem__("dt", 0.0), "dt > 0"),
+        (lambda d: d["centres"].pop(), "same (nonzero) length"),
+    ],
+)
+def test_load_refuses_a_damaged_file_with_what_is_wrong(tmp_path, edit, message):
+    # issue 28 item 7: MultiModel.load validated barely (a KeyError; a NaN theta simulated to
+    # all-NaN); every field is now checked before use
+    rng = np.random.default_rng(4)
+    u = rng.uniform(-1, 1, 3000)
+    y = clpc.simulate_arx([1, -0.5], [0, 0.5], u) + 0.2 * u**2
+    path = tmp_path / "mm.json"
+    clpc.MultiModel(order=1, n_models=3).fit(u, y, dt=0.01).save(path)
+    doc = json.loads(path.read_text())
+    edit(doc)
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match=re.escape(message)):
+        clpc.MultiModel.load(path)

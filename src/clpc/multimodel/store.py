@@ -59,8 +59,32 @@ def to_dict(mm: Any) -> dict[str, Any]:
     }
 
 
+def _field(data: dict[str, Any], key: str, where: str = "the file") -> Any:
+    """``data[key]``, or a ValueError naming the missing field."""
+    if not isinstance(data, dict) or key not in data:
+        raise ValueError(f"{where} has no {key!r} field; it is not a multi-model clpc wrote.")
+    return data[key]
+
+
+def _finite(values: Any, name: str) -> np.ndarray:
+    """``values`` as a float64 array, or a ValueError when an entry is not a finite number."""
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must hold numbers; got {values!r:.80}.") from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite; got {arr.ravel()[:6]} (NaN or inf).")
+    return arr
+
+
 def from_dict(cls: Any, data: dict[str, Any]) -> Any:
-    """Rebuild a multi-model (``cls``) from :func:`to_dict` output; checks the format."""
+    """Rebuild a multi-model (``cls``) from :func:`to_dict` output; checks the format.
+
+    Every field is checked before use: a missing field, a local model whose theta has the
+    wrong length or a non-finite entry, non-finite centres, widths that are not positive (or
+    null for an unbounded one), a sample time that is not positive: a ValueError that says
+    which.
+    """
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise ValueError(
             f"not a clpc multi-model: expected a JSON object with format {FORMAT!r}; got "
@@ -70,15 +94,20 @@ def from_dict(cls: Any, data: dict[str, Any]) -> Any:
         raise ValueError(
             f"unsupported multi-model version {data.get('version')!r}; this clpc reads {VERSION}."
         )
-    s = data["structure"]
-    settings = dict(data["settings"])
+    s = _field(data, "structure")
+    settings = dict(_field(data, "settings"))
     settings.pop("engine", None)  # files written while the free run had an engine setting
-    mm = cls(na=s["na"], nb=s["nb"], nk=s["nk"], schedule=data["schedule"], **settings)
-    mm.n_inputs, mm.dt = int(data["n_inputs"]), float(data["dt"])
+    orders = {key: _field(s, key, "structure") for key in ("na", "nb", "nk")}
+    mm = cls(**orders, schedule=_field(data, "schedule"), **settings)
+    n_inputs, dt = _field(data, "n_inputs"), float(_finite(_field(data, "dt"), "dt"))
+    if not (isinstance(n_inputs, int) and n_inputs >= 1) or dt <= 0:
+        raise ValueError(f"n_inputs must be an int >= 1 and dt > 0; got {n_inputs!r}, {dt!r}.")
+    mm.n_inputs, mm.dt = n_inputs, dt
     structure = mm.structure
     models = []
-    for item in data["local_models"]:
-        theta = np.array(item["theta"], dtype=np.float64)
+    for k, item in enumerate(_field(data, "local_models")):
+        where = f"local model {k}"
+        theta = _finite(_field(item, "theta", where), f"{where}'s theta")
         if theta.shape != (structure.n_params(mm.n_inputs),):
             want = structure.n_params(mm.n_inputs)
             raise ValueError(f"a local model's theta has {theta.size} entries; expected {want}.")
@@ -88,14 +117,17 @@ def from_dict(cls: Any, data: dict[str, Any]) -> Any:
                 structure=structure,
                 n_inputs=mm.n_inputs,
                 mode="siso" if mm.n_inputs == 1 else "miso",
-                c=np.array([float(item["c"])]),
+                c=_finite([_field(item, "c", where)], f"{where}'s c"),
                 dt=mm.dt,
-                info={k: item[k] for k in ("estimator", "replaced", "weight")},
+                info={key: item.get(key) for key in ("estimator", "replaced", "weight")},
             )
         )
-    widths = np.array([math.inf if w is None else float(w) for w in data["widths"]])
-    centres = np.array(data["centres"], dtype=np.float64)
-    if not (centres.size == widths.size == len(models) >= 1):
+    raw_widths = _field(data, "widths")
+    widths = np.array([math.inf if w is None else _finite(w, "widths") for w in raw_widths])
+    if not np.all(widths > 0):
+        raise ValueError(f"widths must be positive (null: unbounded); got {raw_widths!r:.80}.")
+    centres = _finite(_field(data, "centres"), "centres")
+    if not (centres.ndim == 1 and centres.size == widths.size == len(models) >= 1):
         raise ValueError("centres, widths and local_models must have the same (nonzero) length.")
     mm._fitted = Fitted(models, centres, widths, dict(data.get("diagnostics") or {}))
     return mm
