@@ -251,3 +251,38 @@ def test_load_refuses_a_damaged_file_with_what_is_wrong(tmp_path, edit, message)
     path.write_text(json.dumps(doc))
     with pytest.raises(ValueError, match=re.escape(message)):
         clpc.MultiModel.load(path)
+
+
+def test_kstep_prediction_memory_does_not_grow_with_k():
+    # issue 28 item 2: MultiModel.predict(k) kept k full-length arrays; only the last na
+    # (or the schedule's lag) steps are needed
+    import tracemalloc
+
+    rng = np.random.default_rng(5)
+    u = rng.uniform(-1, 1, 40_000)
+    y = clpc.simulate_arx([1, -1.2, 0.5], [0, 0.5, 0.2], u) + 0.2 * u**2
+    mm = clpc.MultiModel(order=2, n_models=3).fit(u, y, dt=0.01)
+
+    def peak(k: int) -> int:
+        tracemalloc.start()
+        mm.predict(u, y, k=k)
+        top = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return top
+
+    assert peak(200) < 1.5 * peak(3)  # a list of k arrays: about 60x here
+
+
+def test_kstep_prediction_of_one_local_model_is_its_linear_prediction():
+    # one local model: validity 1 everywhere, so the multi-model is that linear model and
+    # its k-step predictor must agree with LinearModel.predict (filters, a separate code path)
+    rng = np.random.default_rng(6)
+    u = rng.standard_normal(3000)
+    y = clpc.simulate_arx([1, -1.2, 0.5], [0, 0.5, 0.2], u) + 0.01 * rng.standard_normal(3000)
+    mm = clpc.MultiModel(order=2, n_models=1).fit(u, y, dt=0.01)
+    (local,) = mm.local_models
+    for k in (1, 4, 9):
+        start = mm.structure.max_lag + k
+        np.testing.assert_allclose(
+            mm.predict(u, y, k=k)[start:], local.predict(u, y, k=k)[start:], rtol=1e-9, atol=1e-12
+        )

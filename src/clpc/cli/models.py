@@ -96,11 +96,13 @@ def compare(settings: CompareSettings, as_json: bool) -> None:
     The first max-lag samples give the initial conditions; the fit % (100 = perfect,
     0 = as good as the mean) is computed over the rest. Data whose --dt or --time says
     they are sampled at another rate than the model's are refused; a response that diverges
-    exits 1.
+    exits 1. MODEL.json may also be a multi-model (clpc multimodel --save): it names no
+    columns, so give -u per input and -y.
 
     \b
     Examples:
       clpc compare model.json validation.csv --input uVal --output yVal
+      clpc compare multimodel.json validation.csv -u command -y position
       clpc compare model.json validation.csv -u uVal -y yVal --k 10 --plot cmp.png
     """  # noqa: D301
     result = compare_file(settings)

@@ -28,6 +28,8 @@ from clpc.io.model_schema import (
 )
 from clpc.io.model_validation import model_from_dict
 from clpc.model import LinearModel
+from clpc.multimodel import MultiModel
+from clpc.multimodel.store import FORMAT as MULTIMODEL_FORMAT
 
 #: Largest model file read (bytes); a model with its statistics is a few kB.
 MAX_MODEL_BYTES = 64 * 2**20
@@ -38,6 +40,7 @@ __all__ = [
     "FORMAT",
     "SCHEMA_VERSION",
     "ModelFileError",
+    "load_any_model",
     "load_model",
     "model_from_dict",
     "model_to_dict",
@@ -113,6 +116,39 @@ def load_model(path: str | os.PathLike[str]) -> LinearModel:
         Not JSON (corrupted or truncated), not a clpc model, a newer schema version, or
         invalid content; the message names the file and the problem.
     """
+    p, d = _read_model_json(path)
+    return model_from_dict(d, source=str(p))
+
+
+def load_any_model(path: str | os.PathLike[str]) -> LinearModel | MultiModel:
+    """Read a model file of either kind: a :class:`LinearModel` or a :class:`MultiModel`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file written by :func:`save_model` or :meth:`clpc.MultiModel.save`.
+
+    Returns
+    -------
+    LinearModel or MultiModel
+        Chosen by the file's ``format`` field.
+
+    Raises
+    ------
+    DataFileNotFoundError, ModelFileError
+        As for :func:`load_model`; a damaged multi-model file names the file and the field.
+    """
+    p, d = _read_model_json(path)
+    if d.get("format") == MULTIMODEL_FORMAT:
+        try:
+            return MultiModel.from_dict(d)
+        except (ValueError, TypeError) as exc:
+            raise ModelFileError(f"multi-model file '{p}': {exc}") from None
+    return model_from_dict(d, source=str(p))
+
+
+def _read_model_json(path: str | os.PathLike[str]) -> tuple[Path, dict[str, Any]]:
+    """The file's path and its JSON object, read within the model files' bounds."""
     p = Path(os.fspath(path))
     if not p.exists():
         raise DataFileNotFoundError(
@@ -135,4 +171,4 @@ def load_model(path: str | os.PathLike[str]) -> LinearModel:
         what=f"model file '{p}'",
         constants=NONFINITE,
     )
-    return model_from_dict(d, source=str(p))
+    return p, d

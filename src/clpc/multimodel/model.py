@@ -174,6 +174,15 @@ class MultiModel(ModelFiles):
         return list(self._require().local_models)
 
     @property
+    def warmup(self) -> int:
+        """Samples before the first full prediction: ``max(max_lag, the schedule's lag)``.
+
+        :meth:`simulate` needs this many measured samples as initial conditions and
+        :meth:`predict` returns them as measured.
+        """
+        return max(self.structure.max_lag, self._schedule().lag)
+
+    @property
     def n_models(self) -> int:
         """Number of local models."""
         return len(self._require().local_models)

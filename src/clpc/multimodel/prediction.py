@@ -40,7 +40,10 @@ def predict_kstep(
     for c in range(n_inputs):
         for lag in range(num.shape[2]):
             forced += u2[start - lag : n - lag, c, None] * num[None, :, c, lag]
-    preds = [y1]
+    # step j reads the predictions of steps j - 1 .. j - keep only (output lags, the
+    # schedule's lag): older steps are dropped, so memory is O(T) whatever k is
+    keep = max(s.na, sched.lag if sched.kind == 0 else 1, 1)
+    preds = {0: y1}
     for step in range(1, k + 1):
         local = forced.copy()
         for lag in range(1, s.na + 1):
@@ -52,7 +55,9 @@ def predict_kstep(
         psi = sched.values(u2, ysrc)[start:]
         cur = y1.copy()
         cur[start:] = (validity(psi, f.centres, f.widths) * local).sum(axis=1)
-        preds.append(cur)
+        preds[step] = cur
+        if step - keep > 0:
+            del preds[step - keep]
     return preds[k]
 
 

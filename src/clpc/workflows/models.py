@@ -13,8 +13,11 @@ from clpc.core.compact import compact_repr
 from clpc.core.jsonable import jsonable
 from clpc.data import DataError
 from clpc.io import load_model, read_table, write_table
+from clpc.io.model_files import load_any_model
+from clpc.multimodel import MultiModel
 from clpc.report import model_response
 from clpc.workflows.common import RecordSpec, column_keys, model_columns
+from clpc.workflows.compare_multimodel import compare_multimodel
 
 __all__ = ["CompareResult", "CompareSettings", "SimulateResult", "compare_file", "simulate_file"]
 
@@ -192,8 +195,12 @@ def compare_file(settings: CompareSettings) -> CompareResult:
     ------
     ChannelCountError
         The record's columns do not match the model's channels in number.
+    SettingsError
+        A multi-model file (:class:`clpc.MultiModel`) without ``-u``/``-y`` columns.
     """
-    model = load_model(settings.model_file)
+    model = load_any_model(settings.model_file)
+    if isinstance(model, MultiModel):
+        return _compare_multimodel(model, settings)
     ins = model_columns(model, settings.record.inputs, "input")
     outs = model_columns(model, settings.record.outputs, "output")
     record = dataclasses.replace(settings.record, inputs=tuple(ins), outputs=tuple(outs))
@@ -215,6 +222,20 @@ def compare_file(settings: CompareSettings) -> CompareResult:
 
         plot_compare(data.time, data.y, y_hat, fit, settings.plot, names=outs, label=what)
     return CompareResult(record.file, what, start, data.n_samples, fits, settings.plot or None)
+
+
+def _compare_multimodel(model: MultiModel, settings: CompareSettings) -> CompareResult:
+    comp = compare_multimodel(model, settings.record, settings.k)
+    _check_sample_time(model.dt, comp.dt, settings.record)
+    what = "simulation" if settings.k is None else f"{settings.k}-step prediction"
+    outs = list(settings.record.outputs)
+    if settings.plot:
+        from clpc.plotting import plot_compare
+
+        plot_compare(comp.time, comp.y, comp.y_hat, comp.fit, settings.plot, names=outs, label=what)
+    fits = dict(zip(outs, jsonable(comp.fit), strict=True))
+    n = comp.y.shape[0]
+    return CompareResult(settings.record.file, what, comp.start, n, fits, settings.plot or None)
 
 
 def _check_sample_time(model_dt: float, data_dt: float, record: RecordSpec) -> None:
