@@ -286,3 +286,33 @@ def test_kstep_prediction_of_one_local_model_is_its_linear_prediction():
         np.testing.assert_allclose(
             mm.predict(u, y, k=k)[start:], local.predict(u, y, k=k)[start:], rtol=1e-9, atol=1e-12
         )
+
+
+def test_figure_of_an_integrating_plant_draws_its_integrating_gain(tmp_path):
+    # issue 28 item 7: on an integrator the local DC gains are huge numbers of either sign
+    # (poles just inside or outside z = 1); the figure draws (1 - z^-1) G at z = 1 instead
+    pytest.importorskip("matplotlib")
+    from clpc.plotting.multimodel import integrating_gain, plot_multimodel
+
+    rng = np.random.default_rng(3)
+    n, dt = 20_000, 0.01
+    u = np.repeat(rng.uniform(-1, 1, n // 50), 50) + 0.05 * rng.standard_normal(n)
+    y = np.zeros(n)
+    for k in range(1, n):  # velocity (2 + u) u: its slope in u is 2 + 2u
+        y[k] = y[k - 1] + dt * (2.0 + u[k - 1]) * u[k - 1]
+    y += 1e-3 * rng.standard_normal(n)
+    mm = clpc.MultiModel(order=1, schedule="u").fit(u, y, dt=dt)
+    assert all(m.stability == "integrating" for m in mm.local_models)
+    assert max(abs(float(m.dc_gain()[0, 0])) for m in mm.local_models) > 1e3  # meaningless
+    inner = mm.centres[1:-1]
+    gains = np.array([integrating_gain(m) for m in mm.local_models])[1:-1]
+    np.testing.assert_allclose(gains, 2.0 + 2.0 * inner, atol=0.1)
+    # the closed form on an exact integrator: y(n) = y(n-1) + b u(n-1) gives b / dt
+    theta = np.array([[1.0, -1.0, 0.0, -0.3]])  # [a; b] with G = -B/A = 0.3 z^-1 / (1 - z^-1)
+    exact = clpc.LinearModel(
+        theta=theta, structure=clpc.Structure(1, 1), n_inputs=1, mode="siso", c=np.zeros(1), dt=0.5
+    )
+    np.testing.assert_allclose(exact.numerators[0, 0], [0.0, 0.3])
+    assert integrating_gain(exact) == pytest.approx(0.6, rel=1e-12)
+    plot_multimodel(mm, tmp_path / "mm.png")
+    assert (tmp_path / "mm.png").stat().st_size > 10_000
