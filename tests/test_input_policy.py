@@ -149,3 +149,23 @@ def test_clear_errors_for_careless_arguments():
         IOData([1.0, None, 2.0], [1.0, 2.0, 3.0])
     with pytest.raises(DataError, match="not finite at sample 1"):
         CLPC().push(np.array([1.0, None, 2.0], dtype=object), [1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize("offset", [1e6, 1e9, 1e12])
+def test_an_offset_is_not_a_scale(uy, offset):
+    # issue 28 item 7: identify refused an output logged with a 1e12 offset that track
+    # handled; the solve centres in two passes, so only the variations must fit together
+    u, y = uy
+    logged = y + offset  # what the log holds: y rounded to the offset's precision
+    ref = LPC(na=2, nb=2).fit(u, logged - offset)  # the same rounded samples, no offset
+    moved = LPC(na=2, nb=2).fit(u, logged)
+    # left: the rounding of the offset samples' mean (log2(n) * eps * offset, up to ~2e-3 at
+    # 1e12), a constant the second pass leaves in the centred outputs: the scatter moves by
+    # ~n * 1e-6 against entries ~n * var(y) ~ n, about 1e-8 relative, times the solve's
+    # condition (~10): 1e-7
+    np.testing.assert_allclose(moved.denominators, ref.denominators, rtol=1e-7)
+    np.testing.assert_allclose(moved.numerators, ref.numerators, rtol=1e-7, atol=1e-12)
+    shift = offset * moved.denominators.sum()  # c/a0 carries the offset through A(1)
+    np.testing.assert_allclose(moved.intercept - ref.intercept, shift, rtol=1e-6)
+    trace = CLPC(order=2, window_size=201, cluster_size=12).run(u, y + offset)
+    assert trace.accepted.mean() > 0.5

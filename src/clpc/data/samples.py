@@ -214,16 +214,21 @@ def check_magnitude(arr: np.ndarray, name: str) -> None:
 
 
 def _peaks(arr: np.ndarray) -> np.ndarray:
-    a = np.abs(np.atleast_2d(arr.T).T if arr.ndim == 1 else arr)
-    return a.max(axis=0) if a.shape[0] else np.zeros(a.shape[1])
+    """Largest deviation of each channel from its mean: the scale the centred solve sees."""
+    a = np.atleast_2d(arr.T).T if arr.ndim == 1 else arr
+    if not a.shape[0]:
+        return np.zeros(a.shape[1])
+    return np.abs(a - a.mean(axis=0)).max(axis=0)
 
 
 def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
     """Refuse a whole record that double precision cannot solve (a :class:`DataError`).
 
-    A nonzero channel whose largest magnitude is below :data:`MIN_MAGNITUDE`; with
-    ``scaling="none"``, channels whose largest magnitudes differ by more than
-    :data:`MAX_SPREAD`.
+    A channel that varies, but never by more than :data:`MIN_MAGNITUDE` about its mean; with
+    ``scaling="none"``, channels whose largest deviations from their means differ by more
+    than :data:`MAX_SPREAD`. Deviations, not magnitudes: every solve centres the lag vectors
+    in two passes (eqs. 24-25), so an offset (a position logged as 1e12 counts) costs no
+    precision, and only the channels' variations must fit double precision together.
 
     Parameters
     ----------
@@ -238,8 +243,9 @@ def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
     for p, n in zip(peaks, names, strict=True):
         if 0 < p < MIN_MAGNITUDE:
             raise DataError(
-                f"channel {n} never exceeds {p:.3g}: below {MIN_MAGNITUDE:.0e} this cannot be "
-                "solved in double precision (products of four samples underflow to 0). "
+                f"channel {n} never moves more than {p:.3g} from its mean: below "
+                f"{MIN_MAGNITUDE:.0e} this cannot be solved in double precision (products of "
+                "four samples underflow to 0). "
                 "Rescale the channel (other units, or divide by its RMS)."
             )
     if scaling == "none" and nonzero.sum() > 1:
@@ -248,8 +254,9 @@ def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
             lo = names[int(np.flatnonzero(peaks == small)[0])]
             hi = names[int(np.flatnonzero(peaks == big)[0])]
             raise DataError(
-                f"channel {lo} (up to {small:.3g}) and channel {hi} (up to {big:.3g}) differ "
-                f"in scale by {big / small:.3g} > {MAX_SPREAD:.3g}: with scaling='none' this "
-                "cannot be solved in double precision (the smaller channel falls below the "
+                f"channel {lo} (varying by up to {small:.3g} about its mean) and channel {hi} "
+                f"(up to {big:.3g}) differ in scale by {big / small:.3g} > {MAX_SPREAD:.3g}: "
+                "with scaling='none' this cannot be solved in double precision (the smaller "
+                "channel falls below the "
                 "rounding of the larger). Pass scaling='std', or rescale the channels."
             )
