@@ -194,3 +194,36 @@ def test_no_time_hint_beside_a_missing_column_error(tmp_path):
     res = _run("identify", path, "-u", "u", "-y", "speed")
     assert res.exit_code == 1
     assert len(res.output.strip().splitlines()) == 1 and "speed" in res.output
+
+
+def test_report_draws_the_window_tests_that_rejected_the_sine(sine_csv, noise_csv, tmp_path):
+    # issue 28 item 6: the report said its figure "shows why" no window was accepted; the
+    # window tests (separation and a0 weight against the rule's thresholds) now show it
+    pytest.importorskip("matplotlib")
+    import clpc
+    from clpc.plotting.window_tests import REASONS, first_failure, plot_window_tests
+
+    out = tmp_path / "sine"
+    res = _run("track", sine_csv, "-u", "u", "-y", "y", "--dt", 0.01, "--out", out)
+    assert res.exit_code == 0, res.output
+    assert (out / "tests.png").stat().st_size > 10_000
+    html = (out / "report.html").read_text()
+    assert "Why windows were rejected" in html and "window tests below show why" in html
+    # the figure's points are the trace's own measures; a sine leaves more than one
+    # near-null direction in every full window: "not determined" first
+    data = clpc.load_iodata(sine_csv, "u", "y", time_column="t_s")
+    trace = clpc.CLPC(order=2).run(data)
+    full = trace.rows == trace.rows.max()
+    assert np.all(trace.arrays["n_null"][full, 0] > 1)
+    assert np.all(first_failure(trace, 0)[full] == REASONS.index("not determined"))
+    fig = plot_window_tests(trace)
+    sep_ax = fig.axes[1]
+    drawn = np.concatenate([line.get_ydata() for line in sep_ax.lines[:2]])
+    expected = np.clip(trace.arrays["separation"][:, 0], 1e-6, None)
+    np.testing.assert_array_equal(np.sort(drawn), np.sort(expected))
+    assert sep_ax.lines[2].get_ydata()[0] == clpc.RobustRule().separation
+    # a well-excited record: most windows pass, no tests figure
+    fine = tmp_path / "noise"
+    done = _run("track", noise_csv, "-u", "u", "-y", "y", "--dt", 0.01, "--out", fine)
+    assert done.exit_code == 0
+    assert not (fine / "tests.png").exists()

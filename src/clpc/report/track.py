@@ -17,6 +17,7 @@ from typing import Any
 from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_columns
+from clpc.core.rules import RobustRule
 from clpc.plotting import plot_trace
 from clpc.plotting.track_quantities import (
     BAND_PERCENTILES,
@@ -24,6 +25,7 @@ from clpc.plotting.track_quantities import (
     MIN_SPAN_FRACTION,
     plot_track_quantities,
 )
+from clpc.plotting.window_tests import plot_window_tests
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import model_summary, steady_state, trace_summary
@@ -107,6 +109,21 @@ def _quantities_section(trace: Trace, png: Path) -> Section:
     )
 
 
+def _tests_section(png: Path, rule: RobustRule) -> Section:
+    return Section(
+        "Why windows were rejected",
+        text="Per cluster update, the guard's tests in the order it applies them: enough rows, "
+        "the output excited above its quantization, the model determined; the top panel "
+        "names the first test each update failed. A window determines its model when it has "
+        "one near-null direction, no relation among the inputs alone, and a separation (the "
+        "candidate eigenvalue over the next one outside the near-null subspace) of at most "
+        f"{rule.separation:g}. An input that excites too few orders in the window, such as "
+        "one sine of a slow sweep, leaves several near-null directions, some of them input "
+        "relations. Grey: rejected updates; the dashed line is the threshold.",
+        images=[(png, "the guard's tests of every update")],
+    )
+
+
 def write_track_report(
     out_dir: str | PathLike[str],
     trace: Trace,
@@ -119,6 +136,7 @@ def write_track_report(
     data_t0: float = 0.0,
     steady: tuple[Any, str] | None = None,
     recent: Trace | None = None,
+    rule: RobustRule | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -126,9 +144,9 @@ def write_track_report(
     ----------
     out_dir : str or path-like
         Folder (created) for ``quantities.png`` (DC gain and dominant pole over time, the
-        first figure), ``trace.png``, the figures of the :func:`steady_state` model
-        (when there is one: ``step.png``, ``bode.png``, ``pz.png`` and, with ``data``,
-        ``fit.png`` and ``data.png``) and ``report.html``.
+        first figure), ``trace.png``, ``tests.png`` (see ``rule``), the figures of the
+        :func:`steady_state` model (when there is one: ``step.png``, ``bode.png``,
+        ``pz.png`` and, with ``data``, ``fit.png`` and ``data.png``) and ``report.html``.
     trace : Trace
         The appraiser's output.
     title : str
@@ -151,6 +169,11 @@ def write_track_report(
         (computed from ``trace`` when omitted).
     recent : Trace, optional
         The last updates, unthinned, for the table of the last 20 (default ``trace``).
+    rule : RobustRule, optional
+        The appraiser's thresholds (:attr:`clpc.CLPC.rule`, default ``RobustRule()``), drawn
+        in ``tests.png`` (:func:`clpc.plotting.window_tests.plot_window_tests`) when fewer
+        than :data:`~clpc.appraiser.convergence.MIN_TRUSTED_FRACTION` of the updates were
+        accepted.
 
     Returns
     -------
@@ -190,8 +213,14 @@ def write_track_report(
         more[0].heading = f"Model: {source}"
         sections += more
         files += model_files
-    else:
-        result.text = "The figure of the trace below shows why no estimate was accepted."
+    n = max(int(summary["updates"]), 1)
+    if int(summary["accepted"]) < MIN_TRUSTED_FRACTION * n:
+        tests_png = out / "tests.png"
+        plot_window_tests(trace, tests_png, rule=rule)
+        files.append(tests_png)
+        sections.append(_tests_section(tests_png, rule or RobustRule()))
+        if model is None:
+            result.text = "The window tests below show why no estimate was accepted."
     if summary.get("advice"):
         result.text = "\n\n".join(t for t in (summary["advice"], result.text) if t)
     plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")

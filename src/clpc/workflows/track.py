@@ -451,6 +451,7 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
         summary=summary,
         steady=(model, source),
         recent=run.whole.last,
+        rule=run.appraiser.rule,
         **_report_data(run, trace),
     )
     return TrackResult(summary, model, source, [trace_file, *report])
