@@ -73,6 +73,37 @@ def test_named_pipe_is_read_without_loss(tmp_path, csv_text):
     np.testing.assert_array_equal(table.data, data)
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs named pipes")
+def test_a_pipe_beyond_the_read_limit_is_refused_and_its_copy_removed(tmp_path, monkeypatch):
+    # issue 28 item 2: a FIFO was copied to the temporary folder without limit
+    import tempfile
+
+    monkeypatch.setenv("CLPC_MAX_READ_BYTES", "100000")
+    spool = tmp_path / "spool"
+    spool.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(spool))
+    fifo = tmp_path / "endless.csv"
+    os.mkfifo(fifo)
+    row = "1.0,2.0\n" * 1000
+
+    def feed():
+        try:
+            with open(fifo, "w") as fh:
+                fh.write("u,y\n")
+                for _ in range(100):  # 800 kB, eight times the limit
+                    fh.write(row)
+        except BrokenPipeError:
+            pass  # the reader stopped at its limit and closed the pipe
+
+    t = threading.Thread(target=feed)
+    t.start()
+    with pytest.raises(DataError, match=r"endless\.csv' streams more than the read limit of "
+                       r"100,000 bytes.*CLPC_MAX_READ_BYTES"):  # fmt: skip
+        read_table(fifo)
+    t.join()
+    assert list(spool.iterdir()) == []  # the partial copy is gone
+
+
 def _bomb(path, n, compressed=True):
     save = np.savez_compressed if compressed else np.savez
     save(path, u=np.zeros(n), y=np.ones(n))

@@ -43,6 +43,7 @@ __all__ = [
     "limit",
     "line_too_long",
     "read_too_much",
+    "stream_too_long",
 ]
 
 #: default largest decompressed size of a ``.gz`` text file or of a ``.npz`` archive's members
@@ -86,6 +87,15 @@ def read_too_much(source: str, budget: int | None = None) -> DataError:
         f"{source} decompresses to more than the read limit of {_size(n)} (a compression "
         f"bomb or a very large record?); raise it with the environment variable "
         f"{READ_ENV}=<bytes> if the file is genuine."
+    )
+
+
+def stream_too_long(source: str, budget: int) -> DataError:
+    """The error for a pipe or device that streams more than the read limit ``budget``."""
+    return DataError(
+        f"{source} streams more than the read limit of {_size(budget)} (it is copied to a "
+        f"temporary file to be read); raise it with the environment variable "
+        f"{READ_ENV}=<bytes> if the stream is genuine."
     )
 
 

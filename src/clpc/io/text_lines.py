@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import io
 import re
-import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.io.budget import LINE_ENV, limit, line_too_long
+from clpc.io.budget import LINE_ENV, READ_ENV, limit, line_too_long, stream_too_long
 from clpc.io.errors import show
 from clpc.io.text_format import TextFormat, open_binary
 
@@ -171,10 +170,19 @@ def copy_stream(path: Path) -> tuple[tempfile.TemporaryDirectory[str], Path]:
     """A named pipe or device copied to a temporary file, read once (nothing lost).
 
     The layout is sniffed from the first lines and the data read from the start again:
-    a stream cannot be read twice, so it is copied to disk first (not into memory).
+    a stream cannot be read twice, so it is copied to disk first (not into memory), at most
+    ``CLPC_MAX_READ_BYTES`` of it (:mod:`clpc.io.budget`): an endless device
+    (``/dev/zero``) or a runaway pipe is refused with a ``DataError``, the copy removed.
     """
+    budget = limit(READ_ENV)
     folder = tempfile.TemporaryDirectory(prefix="clpc-")
     copy = Path(folder.name) / path.name
+    copied = 0
     with open(path, "rb") as src, open(copy, "wb") as dst:
-        shutil.copyfileobj(src, dst, 1 << 20)
+        while block := src.read(min(BLOCK_BYTES, budget + 1 - copied)):
+            copied += len(block)
+            if copied > budget:
+                folder.cleanup()
+                raise stream_too_long(f"'{path}'", budget)
+            dst.write(block)
     return folder, copy
