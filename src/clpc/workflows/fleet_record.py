@@ -293,13 +293,13 @@ def track_record(source: RecordSource, settings: FleetSettings, out: str | None)
     -------
     dict
         JSON-safe: ``name``, ``source``, ``key``, ``error`` (``None``, or what went wrong),
-        ``skipped`` (a finished earlier run was reused), ``seconds`` (on the worker),
-        ``worker_pid``, ``folder`` and, without an error, ``samples``, ``updates``,
-        ``accepted``, ``converged``, ``converged_at_s``, ``model_source``, ``den``, ``num``,
+        ``skipped`` (a finished earlier run was reused), ``seconds`` and ``cpu_seconds``
+        (wall and CPU time of this call on the worker's process), ``worker_pid``,
+        ``folder`` and, without an error, ``samples``, ``updates``, ``accepted``, ``converged``, ``converged_at_s``, ``model_source``, ``den``, ``num``,
         ``dt``, ``dc_gain``, ``fit_percent``, ``verdict``, ``gain_drift``, ``drift_time``,
         ``drift_gain``, ``band_hz`` and ``files``.
     """
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     base: dict[str, Any] = {
         "name": source.name,
         "source": source.file if source.file is not None else "<IOData>",
@@ -326,4 +326,5 @@ def track_record(source: RecordSource, settings: FleetSettings, out: str | None)
     except Exception as exc:  # one bad record is a row with its error, not a failed fleet
         row = {**base, "error": f"{type(exc).__name__}: {exc}"}
     row["seconds"] = time.perf_counter() - start
+    row["cpu_seconds"] = time.process_time() - cpu
     return row
