@@ -295,8 +295,9 @@ def track_record(source: RecordSource, settings: FleetSettings, out: str | None)
         JSON-safe: ``name``, ``source``, ``key``, ``error`` (``None``, or what went wrong),
         ``skipped`` (a finished earlier run was reused), ``seconds`` and ``cpu_seconds``
         (wall and CPU time of this call on the worker's process), ``worker_pid``,
-        ``folder`` and, without an error, ``samples``, ``updates``, ``accepted``, ``converged``, ``converged_at_s``, ``model_source``, ``den``, ``num``,
-        ``dt``, ``dc_gain``, ``fit_percent``, ``verdict``, ``gain_drift``, ``drift_time``,
+        ``folder`` and, without an error, ``samples``, ``updates``, ``accepted``,
+        ``converged``, ``converged_at_s``, ``model_source``, ``den``, ``num``, ``dt``,
+        ``dc_gain``, ``fit_percent``, ``verdict``, ``gain_drift``, ``drift_time``,
         ``drift_gain``, ``band_hz`` and ``files``.
     """
     start, cpu = time.perf_counter(), time.process_time()
