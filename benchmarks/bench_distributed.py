@@ -64,7 +64,8 @@ def write_fleet(folder: Path, n_records: int, n_samples: int) -> list[Path]:
 
 def single_process(files: list[Path], out: Path) -> tuple[float, float]:
     """Wall and CPU seconds of tracking every record here, one after the other."""
-    from clpc.workflows.fleet_record import FleetSettings, track_record
+    from clpc.workflows.fleet_record import track_record
+    from clpc.workflows.fleet_settings import FleetSettings
     from clpc.workflows.fleet_sources import expand_sources
 
     settings = FleetSettings.from_keywords(**SETTINGS)
@@ -97,7 +98,8 @@ def on_cluster(client, files: list[Path], out: Path) -> tuple[float, list[dict]]
 
 def warm_worker(file: str, out: str) -> None:
     """Track a short record in this process (imports, numba's cached kernels, matplotlib)."""
-    from clpc.workflows.fleet_record import FleetSettings, track_record
+    from clpc.workflows.fleet_record import track_record
+    from clpc.workflows.fleet_settings import FleetSettings
     from clpc.workflows.fleet_sources import expand_sources
 
     settings = FleetSettings.from_keywords(**SETTINGS)
@@ -107,7 +109,8 @@ def warm_worker(file: str, out: str) -> None:
 
 def task_bytes(files: list[Path], out: Path) -> tuple[int, int]:
     """Pickled size of one task's arguments and of one record's file."""
-    from clpc.workflows.fleet_record import FleetSettings, track_record
+    from clpc.workflows.fleet_record import track_record
+    from clpc.workflows.fleet_settings import FleetSettings
     from clpc.workflows.fleet_sources import expand_sources
 
     settings = FleetSettings.from_keywords(**SETTINGS)

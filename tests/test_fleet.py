@@ -19,7 +19,8 @@ distributed = pytest.importorskip("distributed")
 from clpc import track_many  # noqa: E402
 from clpc.core.output_folder import RECORD_NAME  # noqa: E402
 from clpc.io import load_iodata  # noqa: E402
-from clpc.workflows.fleet_record import ROW_NAME, FleetSettings  # noqa: E402
+from clpc.workflows.fleet_record import ROW_NAME  # noqa: E402
+from clpc.workflows.fleet_settings import FleetSettings  # noqa: E402
 from fleet_sim import write_partitioned  # noqa: E402
 
 SETTINGS = {"inputs": "u", "outputs": "y", "time_col": "t"}

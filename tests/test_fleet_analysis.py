@@ -18,7 +18,7 @@ from clpc.analysis.fleet import (
 )
 from clpc.data import IOData
 from clpc.workflows import SettingsError
-from clpc.workflows.fleet_record import FleetSettings
+from clpc.workflows.fleet_settings import FleetSettings
 from clpc.workflows.fleet_sources import expand_sources, record_name
 
 

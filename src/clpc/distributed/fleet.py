@@ -22,7 +22,8 @@ from collections.abc import Callable
 from typing import Any
 
 from clpc.distributed.cluster import dask_client, require_distributed
-from clpc.workflows.fleet_record import FleetSettings, track_record
+from clpc.workflows.fleet_record import track_record
+from clpc.workflows.fleet_settings import FleetSettings
 from clpc.workflows.fleet_sources import expand_sources
 from clpc.workflows.fleet_table import FleetResult, finish_fleet
 

@@ -69,10 +69,10 @@ def plot_fleet_bode(
     for h, flag in zip(responses, marked, strict=True):
         if not flag:
             label = "records" if n_plain == 0 else None
-            ax.semilogx(freqs, _db(h), color=_GREY, lw=0.8, alpha=0.8, label=label, zorder=2)
+            ax.semilogx(freqs, _db(h), color=_GREY, lw=1.4, alpha=0.8, label=label, zorder=2)
             n_plain += 1
-    ax.semilogx(freqs, _db(reference), color="black", ls="--", lw=1.6, label="fleet median model",
-                zorder=3)  # fmt: skip
+    ax.semilogx(freqs, _db(reference), color="black", dashes=(3, 4), lw=1.0,
+                label="fleet median model", zorder=3)  # fmt: skip
     k = 0
     for h, name, flag in zip(responses, names, marked, strict=True):
         if flag:

@@ -26,7 +26,7 @@ from typing import Any
 from clpc.data import IOData
 from clpc.io.formats import SUPPORTED
 from clpc.workflows.common import SettingsError
-from clpc.workflows.fleet_record import RecordSource
+from clpc.workflows.fleet_settings import RecordSource
 
 __all__ = ["expand_sources", "record_name"]
 
