@@ -29,7 +29,7 @@ CLPC = (sys.executable, "-m", "clpc")
 
 
 def test_a_worker_killed_mid_run_loses_no_record(tmp_path):
-    files = write_csvs(tmp_path / "recs", 6, 2500)
+    files = write_csvs(tmp_path / "recs", 4, 2000)
     killed: dict = {}
     with (
         distributed.LocalCluster(
