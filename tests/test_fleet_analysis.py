@@ -165,3 +165,57 @@ def test_fleet_settings_take_track_s_names_and_refuse_unknown_ones():
         FleetSettings.from_keywords(inputs="u", outputs="y", time_col="t", resample=True)
     with pytest.raises(SettingsError, match="--decimate-to"):
         FleetSettings.from_keywords(inputs="u", outputs="y", decimate_to=0.01)
+
+
+def test_a_record_on_its_own_decimated_equals_track_file(tmp_path):
+    from clpc.workflows import track_file
+    from clpc.workflows.fleet_record import track_record
+    from clpc.workflows.fleet_settings import RecordSource
+    from fleet_sim import axis_record
+
+    path = tmp_path / "a.parquet"
+    axis_record(5, 6000).drop(columns="t").to_parquet(path)
+    settings = FleetSettings.from_keywords(
+        inputs="u", outputs="y", dt=0.001, decimate_to=0.002, window_size=101
+    )
+    row = track_record(RecordSource("a", file=str(path)), settings, str(tmp_path / "out"))
+    assert row["error"] is None, row["error"]
+    direct = track_file(settings.track_settings(str(path), str(tmp_path / "direct")))
+    assert row["dt"] == 0.002 == direct.model.dt and row["samples"] == 6000
+    assert np.array_equal(np.asarray(row["den"]), direct.model.denominators)
+    lo, hi = row["band_hz"]
+    assert 0 < lo < hi <= 0.5 / 0.002  # capped at the decimated model's Nyquist frequency
+    trace = (tmp_path / "out" / "a" / "trace.csv").read_bytes()
+    assert trace == (tmp_path / "direct" / "trace.csv").read_bytes()
+    # without an output folder: the same row, nothing kept
+    alone = track_record(RecordSource("a", file=str(path)), settings, None)
+    assert alone["folder"] is None and alone["den"] == row["den"]
+
+
+def test_track_many_refuses_bad_sources_before_starting_a_cluster(tmp_path):
+    from click.testing import CliRunner
+
+    from clpc.cli import cli
+
+    res = CliRunner().invoke(
+        cli,
+        ["track-many", str(tmp_path / "nope.csv"), "-u", "u", "-y", "y", "--out", str(tmp_path)],
+    )
+    assert res.exit_code == 2 and "no such file or folder" in res.output, res.output
+    res = CliRunner().invoke(
+        cli,
+        [
+            "track-many",
+            str(tmp_path),
+            "-u",
+            "u",
+            "-y",
+            "y",
+            "--out",
+            str(tmp_path),
+            "--time",
+            "t",
+            "--resample",
+        ],
+    )
+    assert res.exit_code == 2 and "cannot resample" in res.output, res.output
