@@ -21,6 +21,9 @@ from clpc.workflows import AppraiserSettings
 
 __all__ = ["track_many"]
 
+#: characters of a record's verdict on its progress line
+_VERDICT_CHARS = 80
+
 
 def _line(done: int, total: int, row: dict[str, Any]) -> None:
     """One line per finished record on standard error."""
@@ -31,9 +34,12 @@ def _line(done: int, total: int, row: dict[str, Any]) -> None:
     fit = row.get("fit_percent") or []
     shown = ", ".join("-" if f is None else f"{f:.1f} %" for f in fit) or "-"
     again = " (finished earlier: reused)" if row.get("skipped") else ""
+    verdict = str(row["verdict"])
+    if len(verdict) > _VERDICT_CHARS:  # the whole verdict is in the table and the reports
+        verdict = verdict[: _VERDICT_CHARS - 3] + "..."
     click.echo(
         f"{head}: {row['samples']} samples, {row['updates']} updates, fit {shown}, "
-        f"{row['verdict']}{again} [{row['seconds']:.1f} s]",
+        f"{verdict}{again} [{row['seconds']:.1f} s]",
         err=True,
     )
 

@@ -89,6 +89,11 @@ def track_many(
         Sources that name nothing (see :func:`expand_sources`) or contradictory settings.
     TypeError
         An unknown setting.
+
+    Notes
+    -----
+    A local cluster's workers are started as new Python processes that import the calling
+    script again: in a script, call ``track_many`` under ``if __name__ == "__main__":``.
     """
     distributed = require_distributed()
     fleet = FleetSettings.from_keywords(**settings)
