@@ -37,3 +37,14 @@ def test_zero_workers_is_refused():
     with pytest.raises(ValueError, match="at least 1"):
         with dask_client(workers=0):
             pass
+
+
+def _profiling() -> bool:
+    import dask
+
+    return bool(dask.config.get("distributed.worker.profile.enabled"))
+
+
+def test_the_local_cluster_runs_its_workers_without_the_statistical_profiler():
+    with dask_client(workers=1) as client:
+        assert list(client.run(_profiling).values()) == [False]

@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # the names mypy and editors see; at run time they load on fi
     from clpc.analysis.operating_point import operating_point_diagnostics
     from clpc.appraiser import CLPC, Convergence, Trace
     from clpc.data import DataError, IOData, as_iodata
+    from clpc.distributed.fleet import track_many
     from clpc.io import load_iodata, load_model, read_table, save_model, write_table
     from clpc.lpc import (
         ARX,
@@ -107,6 +108,7 @@ _LAZY: dict[str, str] = {
     ),
     **dict.fromkeys(("ResidualAnalysis", "residual_analysis"), "clpc.model.residuals"),
     "MultiModel": "clpc.multimodel",
+    "track_many": "clpc.distributed.fleet",
 }
 
 
@@ -176,6 +178,7 @@ __all__ = [
     "select_delay",
     "select_order",
     "simulate_arx",
+    "track_many",
     "vaf",
     "whiteness_test",
     "write_table",

@@ -26,6 +26,7 @@ __all__ = ["COMMANDS", "cli", "main", "run"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "identify": ("clpc.cli.identify", "identify"),
     "track": ("clpc.cli.track", "track"),
+    "track-many": ("clpc.cli.track_many", "track_many"),
     "stream": ("clpc.cli.stream", "stream"),
     "simulate": ("clpc.cli.models", "simulate"),
     "compare": ("clpc.cli.models", "compare"),

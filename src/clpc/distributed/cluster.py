@@ -26,6 +26,13 @@ INSTALL_HINT = (
 )
 
 
+#: Dask's statistical profiler samples each worker's stack every 10 ms (for the dashboard's
+#: profile page); on clpc's records it costs about a tenth of a worker's CPU, so the local
+#: clusters clpc starts run without it (``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``
+#: does the same for ``dask worker``; see docs/distributed.md)
+NO_PROFILER = {"distributed.worker.profile.enabled": False}
+
+
 def require_distributed() -> Any:
     """Import and return ``distributed``, or raise ImportError saying how to install it."""
     try:
@@ -82,7 +89,10 @@ def dask_client(
     n_workers = default_workers() if workers is None else int(workers)
     if n_workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
+    import dask
+
     with (
+        dask.config.set(NO_PROFILER),  # the nannies hand this config to their workers
         distributed.LocalCluster(
             n_workers=n_workers,
             threads_per_worker=1,

@@ -24,7 +24,7 @@ from clpc.io import iter_table_chunks, save_model
 from clpc.io.roles import check_column_roles
 from clpc.io.text_format import sniff
 from clpc.model import LinearModel
-from clpc.report import steady_state, trace_summary, write_track_report
+from clpc.report import model_response, steady_state, trace_summary, write_track_report
 from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 from clpc.workflows.save_check import save_refusal
 from clpc.workflows.track_advice import excitation_advice
@@ -101,6 +101,16 @@ class TrackResult:
     save_refused : str or None
         Why ``--save`` saved nothing although a model exists (one line, see
         :func:`clpc.workflows.save_check.save_refusal`); ``None`` otherwise.
+    fit : list of float or None, optional
+        Fit % of the model's free-run simulation per output on the samples the report
+        compares it with (:func:`clpc.report.model_response`; ``None`` where it diverges),
+        ``None`` without a model or without enough samples.
+    trace : Trace, optional
+        The (thinned) trace the figures draw (see ``figure_updates``).
+    samples : int
+        Rows read from the record (before any decimation).
+    data_dt : float
+        The record's sample time [s] (1 when neither ``dt`` nor a time column gives it).
     """
 
     summary: dict[str, Any]
@@ -108,6 +118,10 @@ class TrackResult:
     model_source: str
     files: list[Path]
     save_refused: str | None = None
+    fit: list[float | None] | None = None
+    trace: Trace | None = None
+    samples: int = 0
+    data_dt: float = 1.0
 
 
 def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
@@ -273,6 +287,7 @@ class _Run:
     kept: ThinnedTrace
     n_raw: int
     tail: _Tail
+    data_dt: float
     whole: _SummaryTrace = field(default_factory=_SummaryTrace)
 
 
@@ -298,7 +313,7 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
                 appraiser = settings.appraiser.build(data_dt)
                 rate = data_dt if data_dt is not None else appraiser.dt
                 factor = decimation_factor(appraiser.decimate_to, rate)
-                run = _Run(appraiser, kept, 0, _Tail(factor))
+                run = _Run(appraiser, kept, 0, _Tail(factor), rate)
             run.n_raw += values.shape[0]
             run.tail.feed(values[:, : n_in + n_out])
             _push(run, names, values, writer, n_in, n_out)
@@ -443,6 +458,7 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
     u_tail = run.tail.rows[:, : len(record.inputs)]
     summary["advice"] = excitation_advice(whole, u_tail, settings.appraiser.window_size, command)
     model, source = steady_state(whole)
+    shown = _report_data(run, trace)
     report = write_track_report(
         out,
         trace,
@@ -452,6 +468,11 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
         steady=(model, source),
         recent=run.whole.last,
         rule=run.appraiser.rule,
-        **_report_data(run, trace),
+        **shown,
     )
-    return TrackResult(summary, model, source, [trace_file, *report])
+    fit = None
+    if model is not None and "data" in shown:
+        data = shown["data"]
+        fit = [None if f != f else float(f) for f in model_response(model, data.u, data.y)[2]]
+    files = [trace_file, *report]
+    return TrackResult(summary, model, source, files, None, fit, trace, run.n_raw, run.data_dt)
