@@ -101,16 +101,17 @@ def test_track_gives_no_advice_when_the_input_excites_enough(noise_csv, tmp_path
 
 
 class _Trace:
-    """The least of a trace that :func:`excitation_advice` reads."""
+    """The least of a scanned trace that :func:`excitation_advice` reads."""
 
     def __init__(self, accepted: np.ndarray, relations: np.ndarray) -> None:
         from clpc.model.structure import Structure
 
-        self.arrays = {"accepted": accepted[:, None], "n_input_relations": relations[:, None]}
+        self.counts = {"accepted": int(accepted.sum()), "lacking": int((relations > 0).sum())}
         self.structure = Structure(2, 2, 0)
+        self.n = accepted.size
 
     def __len__(self) -> int:
-        return len(self.arrays["accepted"])
+        return self.n
 
 
 @pytest.mark.parametrize(

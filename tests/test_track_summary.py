@@ -60,18 +60,29 @@ def test_summary_counts_convergence_and_model_come_from_the_full_trace(long_reco
     assert f'<td class="num">{len(full)}</td>' in html
 
 
-def test_the_whole_record_is_kept_in_104_bytes_per_update(long_record):
-    from clpc.workflows.track import _SummaryTrace
+def test_the_summary_memory_does_not_grow_with_the_record(long_record, tmp_path):
+    # issue 28 item 2: the summary kept every update (104 bytes each); now the parts are
+    # scanned once and only the rows after convergence are kept, in a scratch file
+    import tracemalloc
+
+    from clpc.appraiser.scanned import ScannedTrace
 
     _, u, y = long_record
-    full = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)
-    kept = _SummaryTrace()
-    kept.add(full)
-    whole = kept.trace()
+    part = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)
 
-    def size(t):
-        per = [t.index, t.time, t.rows, t.not_enough_data, *t.arrays.values()]
-        return sum(a.nbytes for a in per) / len(t)
+    def peak(n_parts: int) -> int:
+        scanned = ScannedTrace(tmp_path)
+        tracemalloc.start()
+        for _ in range(n_parts):
+            scanned.add(part)
+        scanned.convergence()
+        top = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert len(scanned) == n_parts * len(part)
+        scanned.close()
+        return top
 
-    assert size(whole) == 104  # one output, 6 parameters: the figure in the docstring
-    assert size(whole) < size(full) / 2.9
+    # both past one block of the second pass (BLOCK_ROWS rows after convergence)
+    small, large = peak(40), peak(200)
+    # 160 more parts of 595 updates: 9.9 MB if every update were kept at 104 bytes
+    assert large < small + 200_000, (small, large)

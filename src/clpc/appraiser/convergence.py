@@ -19,10 +19,21 @@ from clpc.appraiser.spread import (
     level_trend,
     window_dc_gains,
 )
+from clpc.appraiser.trace_scan import RowSpill, ScanState, sequential_mean, usable
 from clpc.core.compact import compact_repr
 from clpc.model import LinearModel
 
-__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "convergence", "steady_state_model", "usable"]
+__all__ = [
+    "MIN_TRUSTED_FRACTION",
+    "Convergence",
+    "convergence",
+    "convergence_of",
+    "model_of",
+    "no_steady_state",
+    "normalised",
+    "steady_state_model",
+    "usable",
+]
 
 
 @compact_repr
@@ -73,29 +84,6 @@ class Convergence:
 MIN_TRUSTED_FRACTION = 0.5
 
 
-def usable(trace: Any) -> np.ndarray:
-    """Updates that count for convergence and the steady state, shape ``(len(trace),)``.
-
-    Accepted, holding a model and from a trusted window, for every equation (traces
-    without a ``trusted`` column: accepted and holding a model).
-
-    Parameters
-    ----------
-    trace : Trace
-        A CLPC trace.
-
-    Returns
-    -------
-    ndarray of bool, shape (n_updates,)
-    """
-    arrays = trace.arrays
-    ok = arrays["accepted"].all(axis=1) & arrays["has_model"].all(axis=1)
-    trusted = arrays.get("trusted")
-    if trusted is not None:
-        ok = ok & trusted.all(axis=1)
-    return np.asarray(ok, dtype=bool)
-
-
 def convergence(
     trace: Any, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
 ) -> Convergence:
@@ -107,21 +95,20 @@ def convergence(
     updates in a row. Only updates from trusted windows count (:func:`usable`): with
     ``guard=False`` the appraiser also accepts untrusted ones, which say nothing reliable.
     """
-    acc = usable(trace)
-    theta = trace.arrays["theta"]
-    d: np.ndarray = trace.arrays["D"]
-    n = len(trace)
-    quiet: np.ndarray = np.zeros(n, dtype=bool)
-    if n > 1:
-        dtheta = np.linalg.norm(theta[1:] - theta[:-1], axis=2).max(axis=1)
-        scale = np.maximum(np.abs(d[1:]), np.finfo(float).tiny)
-        dd = (np.abs(d[1:] - d[:-1]) / scale).max(axis=1)
-        quiet[1:] = acc[1:] & acc[:-1] & (dtheta < theta_tol) & (dd < D_tol)
-    window = np.ones(consecutive, dtype=int)
-    run = np.convolve(quiet.astype(int), window, "valid") if n >= consecutive else window[:0]
-    hits = np.flatnonzero(run == consecutive)
-    trusted = trace.arrays.get("trusted")
-    frac = float(trusted.all(axis=1).mean()) if trusted is not None and n else 1.0
+    state = ScanState(theta_tol, D_tol, consecutive, RowSpill())
+    state.add(trace)
+    return convergence_of(state)
+
+
+def convergence_of(state: ScanState) -> Convergence:
+    """The :class:`Convergence` of the updates a :class:`ScanState` was fed.
+
+    The variations need one more pass, over the rows after the convergence point that the
+    state spilled (in memory, or in a scratch file for a trace read from disk).
+    """
+    n = state.n
+    theta_tol, D_tol, consecutive = state.theta_tol, state.D_tol, state.consecutive
+    frac = state.trusted / n if state.trusted is not None and n else 1.0
     none = (float("nan"), theta_tol, D_tol, consecutive, float("nan"), float("nan"))
     if frac < MIN_TRUSTED_FRACTION:
         why = (
@@ -130,35 +117,26 @@ def convergence(
             "determined)"
         )
         return Convergence(False, -1, -1, *none, frac, why)
-    if hits.size == 0:
+    if state.start < 0:
         why = (
             f"not converged: no {consecutive} trusted, accepted updates in a row moved theta by "
             f"less than {theta_tol:g} and D by less than {D_tol:.0%}"
         )
         return Convergence(False, -1, -1, *none, frac, why)
-    start = int(hits[0])
-    after = acc & (np.arange(n) >= start)
-    ss = _mean_theta(theta[after])
-    th_var = float(np.linalg.norm(theta[after] - ss[None], axis=2).max())
-    d_mean = d[after].mean(axis=0)
-    d_var = float((np.abs(d[after] - d_mean) / np.maximum(d_mean, 1e-300)).max())
+    ss = normalised(state.mean("theta"))
+    d_mean = state.mean("D")
+    th_var = d_var = 0.0
+    for theta, d in state.spill.blocks():
+        th_var = max(th_var, float(np.linalg.norm(theta - ss[None], axis=2).max()))
+        d_var = max(d_var, float((np.abs(d - d_mean) / np.maximum(d_mean, 1e-300)).max()))
     why = (
-        f"converged at update {start + 1}: {consecutive} trusted, accepted updates in a row "
-        f"moved theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; "
+        f"converged at update {state.start + 1}: {consecutive} trusted, accepted updates in a "
+        f"row moved theta by less than {theta_tol:g} and D by less than {D_tol:.0%}; "
         f"{frac:.0%} of the windows are trusted"
     )
+    index, time = state.start_at
     return Convergence(
-        True,
-        start,
-        int(trace.index[start]),
-        float(trace.time[start]),
-        theta_tol,
-        D_tol,
-        consecutive,
-        th_var,
-        d_var,
-        frac,
-        why,
+        True, state.start, index, time, theta_tol, D_tol, consecutive, th_var, d_var, frac, why
     )
 
 
@@ -182,29 +160,41 @@ def steady_state_model(
         sel = np.zeros(len(trace), dtype=bool)
         sel[np.flatnonzero(acc)[-1]] = True
     else:
-        raise ValueError(
-            "the trace never became quasi-constant (no steady state): "
-            f"{int(acc.sum())} of {len(trace)} updates were accepted; {conv.reason}. Use "
-            "a longer record, a richer input, larger tolerances, or allow_unconverged=True."
-        )
+        raise no_steady_state(int(acc.sum()), len(trace), conv)
     theta = _mean_theta(trace.arrays["theta"][sel])
-    c = trace.arrays["c"][sel].mean(axis=0)
+    c = sequential_mean(trace.arrays["c"][sel])
     spread = _warn_if_windows_disagree(trace, sel)
+    return model_of(trace, theta, c, conv, int(sel.sum()), spread)
+
+
+def no_steady_state(accepted: int, n: int, conv: Convergence) -> ValueError:
+    """The error of a trace with no steady state (and ``allow_unconverged=False``)."""
+    return ValueError(
+        "the trace never became quasi-constant (no steady state): "
+        f"{accepted} of {n} updates were accepted; {conv.reason}. Use "
+        "a longer record, a richer input, larger tolerances, or allow_unconverged=True."
+    )
+
+
+def model_of(
+    like: Any, theta: np.ndarray, c: np.ndarray, conv: Convergence, used: int, spread: Any
+) -> LinearModel:
+    """The steady-state :class:`LinearModel` of a trace (``like``: its labels)."""
     return LinearModel(
         theta=theta,
-        structure=trace.structure,
-        n_inputs=trace.n_inputs,
-        mode=trace.mode,
+        structure=like.structure,
+        n_inputs=like.n_inputs,
+        mode=like.mode,
         c=c,
-        dt=trace.sample_time,
-        input_names=trace.input_names,
-        output_names=trace.output_names,
+        dt=like.sample_time,
+        input_names=like.input_names,
+        output_names=like.output_names,
         info={
             "convergence": conv,
             "method": "clpc-steady-state",
-            "scaling": trace.meta.get("scaling"),
-            "guard": trace.meta.get("guard"),
-            "updates_used": int(sel.sum()),
+            "scaling": like.meta.get("scaling"),
+            "guard": like.meta.get("guard"),
+            "updates_used": used,
             "gain_spread": spread,
         },
     )
@@ -243,5 +233,9 @@ def _warn_if_windows_disagree(trace: Any, sel: np.ndarray) -> float | None:
 
 def _mean_theta(theta: np.ndarray) -> np.ndarray:
     """Mean of unit vectors (a0 > 0 already), renormalised: shape (E, p)."""
-    mean = theta.mean(axis=0)
+    return normalised(sequential_mean(theta))
+
+
+def normalised(mean: np.ndarray) -> np.ndarray:
+    """Each row of ``mean`` (E, p) divided by its norm."""
     return mean / np.linalg.norm(mean, axis=1, keepdims=True)

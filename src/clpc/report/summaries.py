@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from clpc.analysis.metrics import fit_percent
+from clpc.appraiser.scanned import ScannedTrace
 from clpc.appraiser.trace import SCALAR_KEYS, Trace
 from clpc.core.jsonable import jsonable
 from clpc.core.polynomials import pole_class
@@ -25,7 +26,7 @@ from clpc.data import IOData
 from clpc.model import LinearModel, ModelError
 from clpc.model.residuals import residual_analysis
 from clpc.model.uncertainty import parameter_labels, parameter_std, parameter_vector
-from clpc.model.verdict import describe_trace, fit_verdict
+from clpc.model.verdict import fit_verdict
 from clpc.report.identifiability import identifiability_summary
 
 __all__ = [
@@ -263,14 +264,14 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
     return records
 
 
-def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
+def steady_state(trace: Trace | ScannedTrace) -> tuple[LinearModel | None, str]:
     """The model a trace settles on, and where it comes from.
 
     Parameters
     ----------
-    trace : Trace
-        A CLPC trace (:class:`clpc.Trace`); convergence is judged with the default
-        tolerances of :meth:`Trace.convergence`.
+    trace : Trace or ScannedTrace
+        A CLPC trace (:class:`clpc.Trace`), or one read in parts; convergence is judged
+        with the default tolerances of :meth:`Trace.convergence`.
 
     Returns
     -------
@@ -290,14 +291,15 @@ def steady_state(trace: Trace) -> tuple[LinearModel | None, str]:
     return model, "last accepted update (not converged)"
 
 
-def trace_summary(trace: Trace) -> dict[str, Any]:
+def trace_summary(trace: Trace | ScannedTrace) -> dict[str, Any]:
     """Counts, convergence and plain-language findings of a CLPC trace, JSON-safe.
 
     Parameters
     ----------
-    trace : Trace
-        A CLPC trace (:class:`clpc.Trace`); convergence is judged with the default
-        tolerances of :meth:`Trace.convergence`.
+    trace : Trace or ScannedTrace
+        A CLPC trace (:class:`clpc.Trace`), or one read in parts
+        (:class:`clpc.appraiser.scanned.ScannedTrace`: the same numbers in bounded memory);
+        convergence is judged with the default tolerances of :meth:`Trace.convergence`.
 
     Returns
     -------
@@ -308,16 +310,16 @@ def trace_summary(trace: Trace) -> dict[str, Any]:
         (:func:`clpc.describe_trace`) and ``model`` (:func:`model_summary` of
         :func:`steady_state`, or ``None``) with ``model_source``.
     """
-    a = trace.arrays
-    conv = trace.convergence()
-    model, source = steady_state(trace)
-    n = len(trace)
+    scan = trace if isinstance(trace, ScannedTrace) else ScannedTrace.of(trace)
+    conv = scan.convergence()
+    model, source = steady_state(scan if isinstance(trace, ScannedTrace) else trace)
+    counts, n = scan.counts, len(scan)
     return {
         "updates": n,
-        "accepted": int(a["accepted"].all(axis=1).sum()),
-        "determined": int(a["determined"].all(axis=1).sum()),
-        "not_enough_data": int(np.sum(trace.not_enough_data)),
-        "D_last": jsonable(a["D"][-1]) if n else None,
+        "accepted": counts["accepted"],
+        "determined": counts["determined"],
+        "not_enough_data": counts["not_enough_data"],
+        "D_last": jsonable(scan.D_last) if n else None,
         "convergence": jsonable(
             {
                 "converged": conv.converged,
@@ -328,7 +330,7 @@ def trace_summary(trace: Trace) -> dict[str, Any]:
                 "D_variation": conv.D_variation,
             }
         ),
-        "findings": describe_trace(trace) if n else [],
+        "findings": scan.findings.lines() if n else [],
         "model_source": source,
         "model": None if model is None else model_summary(model),
     }

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -12,6 +13,7 @@ import numpy as np
 
 from clpc.appraiser import CLPC
 from clpc.appraiser.decimation import Decimator, decimation_factor
+from clpc.appraiser.scanned import ScannedTrace
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
@@ -223,62 +225,6 @@ class _Tail:
         self.rows = both[-REPORT_SAMPLES:]
 
 
-#: the per-update arrays that counts, convergence, findings and the steady-state model use
-_SUMMARY_KEYS = (
-    "theta",
-    "D",
-    "c",
-    "accepted",
-    "has_model",
-    "trusted",
-    "determined",
-    "degenerate",
-    "excited",
-    "n_input_relations",
-    "stable",
-)
-
-
-_RECENT = 20  # updates in the report's table of the last updates
-
-
-def _tail(trace: Trace, n: int) -> Trace:
-    return dataclasses.replace(
-        trace,
-        index=trace.index[-n:],
-        time=trace.time[-n:],
-        rows=trace.rows[-n:],
-        not_enough_data=trace.not_enough_data[-n:],
-        arrays={k: v[-n:] for k, v in trace.arrays.items()},
-    )
-
-
-class _SummaryTrace:
-    """Every update of the run, with only the arrays :func:`trace_summary` reads.
-
-    104 bytes per update for one output with ``order=2`` (6 parameters), a third
-    of a full trace row: a record of 1e7 samples with ``cluster=12`` (8.3e5 updates) keeps
-    about 87 MB.
-    """
-
-    def __init__(self) -> None:
-        self._parts: list[Trace] = []
-        self.last: Trace | None = None
-
-    def add(self, part: Trace) -> None:
-        arrays = {k: part.arrays[k] for k in _SUMMARY_KEYS if k in part.arrays}
-        self._parts.append(dataclasses.replace(part, arrays=arrays))
-        if self.last is not None and len(part) < _RECENT:
-            part = Trace.concat([self.last, part])
-        n = len(part)
-        self.last = part if n <= _RECENT else _tail(part, _RECENT)
-
-    def trace(self) -> Trace:
-        merged = Trace.concat(self._parts)
-        self._parts = [merged]
-        return merged
-
-
 @dataclass
 class _Run:
     """The state of one pass over the record."""
@@ -288,7 +234,7 @@ class _Run:
     n_raw: int
     tail: _Tail
     data_dt: float
-    whole: _SummaryTrace = field(default_factory=_SummaryTrace)
+    whole: ScannedTrace = field(default_factory=lambda: ScannedTrace(Path(tempfile.gettempdir())))
 
 
 def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter | None) -> _Run:
@@ -392,8 +338,9 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     are complete, the previous run's files replaced; an error or a kill leaves ``OUT`` as
     it was.
     The figures use a thinned copy of the trace when there are many updates; every count,
-    the convergence point and the steady-state model come from all updates (kept in memory
-    with only the arrays they need, see :class:`_SummaryTrace`).
+    the convergence point and the steady-state model come from all updates, gathered in one
+    pass in memory that does not grow with the record
+    (:class:`clpc.appraiser.scanned.ScannedTrace`).
 
     Parameters
     ----------
@@ -427,7 +374,10 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     with OutputFolder(settings.out_dir, "--out") as folder:
         trace_file = folder.staging / f"trace.{settings.fmt}"
         run = _appraise(settings, trace_file, progress)
-        result = _finish(settings, run, trace_file, folder.staging)
+        try:
+            result = _finish(settings, run, trace_file, folder.staging)
+        finally:
+            run.whole.close()
         folder.commit()
         files = [folder.final(f) for f in result.files]
     refused = None
@@ -443,7 +393,7 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
     """The report of an appraised record, written into ``out``."""
     _check_long_enough(run, settings, trace_file)
     trace = run.kept.trace()
-    whole = run.whole.trace()
+    whole = run.whole
     file = settings.record.file
     report_settings = {
         "file": file,

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION
+from clpc.appraiser.scanned import ScannedTrace
 from clpc.model.excitation import EXCITATION_RTOL, excitation_ratios, needed_order
 
 __all__ = ["excitation_advice"]
@@ -50,8 +51,9 @@ def excitation_advice(
 
     Parameters
     ----------
-    trace : Trace
-        Every update of the run (needs the arrays ``accepted`` and ``n_input_relations``).
+    trace : Trace or ScannedTrace
+        Every update of the run, in memory or scanned in parts (its ``counts`` of
+        ``accepted`` updates and of updates ``lacking`` excitation, and ``structure``).
     u_tail : ndarray, shape (T, n_inputs)
         The record's last input samples at the appraiser's rate (``T`` may be 0).
     window_size : int
@@ -71,11 +73,11 @@ def excitation_advice(
         tail of the record, and what would help: a richer input, a lower ``--nb``, a
         longer ``--window-size``, or ``clpc identify`` on the whole record.
     """
-    n = len(trace)
+    scan = trace if hasattr(trace, "counts") else ScannedTrace.of(trace)
+    n = len(scan)
     if n == 0:
         return None
-    accepted = int(np.asarray(trace.arrays["accepted"]).all(axis=1).sum())
-    lacking = int((np.asarray(trace.arrays["n_input_relations"]) > 0).any(axis=1).sum())
+    accepted, lacking = scan.counts["accepted"], scan.counts["lacking"]
     if accepted >= MIN_TRUSTED_FRACTION * n or lacking == 0 or 2 * lacking < n - accepted:
         return None
     s = trace.structure
