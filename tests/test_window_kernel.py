@@ -120,6 +120,10 @@ PARITY_CASES = [
     ({"cluster_size": 1, "window_size": 40}, 1, 1),
     ({"mimo": "miso"}, 2, 2),
     ({"mimo": "paired", "method": "paper"}, 2, 2),
+    # blocks of B > C rows (kernel.block_rows): tail, full blocks and a head piece
+    ({"cluster_size": 1}, 1, 1),
+    ({"cluster_size": 5, "method": "paper"}, 1, 1),
+    ({"mimo": "miso", "cluster_size": 3, "window_size": 90}, 2, 2),
 ]
 
 
@@ -234,13 +238,23 @@ def test_kernel_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
         assert fast.degenerate.all() and not fast.has_model.any()
 
 
-def test_compiled_stream_and_step_are_bit_identical_to_run():
+def test_block_rows_balance_pieces_and_merge():
+    assert kernel.block_rows(201, 12) == 12  # the paper's settings: B = C, no head piece
+    assert kernel.block_rows(201, 1) == 14
+    assert kernel.block_rows(201, 5) == 15
+    assert kernel.block_rows(40, 1) == 6
+    assert kernel.block_rows(10, 12) == 12
+
+
+@pytest.mark.parametrize(("window", "cluster"), [(201, 12), (201, 1), (150, 4)])
+def test_compiled_stream_and_step_are_bit_identical_to_run(window, cluster):
     u, y = _record(2000, seed=9, offset=1e4)
     u, y = u[:, 0], y[:, 0]
-    batch = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
-    a = CLPC(order=2, window_size=201, cluster_size=12)
+    settings = {"order": 2, "window_size": window, "cluster_size": cluster}
+    batch = CLPC(**settings).run(u, y)
+    a = CLPC(**settings)
     pushed = Trace.concat([a.push(u[i : i + 97], y[i : i + 97]) for i in range(0, 2000, 97)])
-    b = CLPC(order=2, window_size=201, cluster_size=12)
+    b = CLPC(**settings)
     # python and numpy scalars take the light path, arrays the general one
     feeds = [float, np.float64, lambda v: np.array([v])]
     stepped = [b.step(feeds[k % 3](u[k]), feeds[k % 3](y[k])) for k in range(2000)]
@@ -248,7 +262,7 @@ def test_compiled_stream_and_step_are_bit_identical_to_run():
     for key in ("theta", "D", "eigenvalues", "c", "den", "J"):
         np.testing.assert_array_equal(pushed.arrays[key], batch.arrays[key], key)
         np.testing.assert_array_equal(stepped.arrays[key], batch.arrays[key], key)
-    assert b.counter == a.counter == (2000 - 2) % 12
+    assert b.counter == a.counter == (2000 - 2) % cluster
 
 
 def test_step_with_integer_and_float32_samples():

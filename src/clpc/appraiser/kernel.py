@@ -13,10 +13,15 @@ A window's numbers depend only on its own rows, never on how a record was chunke
 
 Windows (section V; ``docs/clpc.md``): update ``j`` closes after lag row ``e = C j`` and
 uses rows ``[s, e)``, ``s = max(0, e - W)``: the window grows until it holds ``W`` rows,
-then slides. Cut the lag rows into blocks ``[l C, (l + 1) C)``; a window is::
+then slides. Cut the lag rows into blocks ``[l B, (l + 1) B)`` of ``B`` rows, a multiple
+of ``C`` (:func:`block_rows`: ``B = C`` unless ``C`` is small against ``sqrt(W)``); a
+window is::
 
-    tail of the block holding s (its last rows)  +  the full blocks up to e
-    \____________ computed per window _________/    \___ once per block __/
+    tail: rows of s's block  +  the full blocks  +  head: rows of e's block before e
+    \_ computed per window _/    \_ once per block _/   \_____ computed per window ____/
+
+(with ``B = C`` the head is empty). The blocks are aligned to absolute row numbers, so
+the pieces of a window do not depend on how the record was chunked either.
 
 Each piece is summarised by its count, mean and centered scatter (two-pass), and pieces
 are merged with the formula of Chan, Golub and LeVeque::
@@ -95,6 +100,7 @@ class WindowPlan(NamedTuple):
     window: int  #: W, lag rows per window
     cluster: int  #: C, lag rows between updates
     min_rows: int  #: windows with fewer rows are "not enough data": no solve runs
+    block: int  #: B, rows of a block summarised once (a multiple of C; see block_rows)
 
 
 class Solved(NamedTuple):
@@ -241,38 +247,48 @@ def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, i
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def merge(
     blocks: tuple[np.ndarray, np.ndarray, int, int, int],
-    tail: tuple[int, np.ndarray, np.ndarray],
+    pieces: tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray],
     dev: np.ndarray,
     out: tuple[np.ndarray, np.ndarray],
 ) -> float:
-    """Merge full blocks and a tail piece into one window (Chan, Golub and LeVeque).
+    """Merge full blocks, a tail and a head piece into one window (Chan, Golub and LeVeque).
 
     ``blocks = (b_mean (n, p), b_scat (n, p, p), lo, hi, size)``: blocks ``lo .. hi - 1``
-    of ``size`` rows; ``tail = (t_size, t_mean, t_scat)`` (skipped when ``t_size`` is 0);
-    ``dev`` work space (pieces, p); ``out = (mean, scat)``. Returns the row count.
+    of ``size`` rows; ``pieces = (t_size, t_mean, t_scat, h_size, h_mean, h_scat)``: the
+    tail (the rows before the first full block) and the head (the rows after the last);
+    a piece of size 0 is skipped. ``dev`` work space (pieces, p); ``out = (mean, scat)``.
+    Returns the row count.
     """
     b_mean, b_scat, lo, hi, size = blocks
-    t_size, t_mean, t_scat = tail
+    t_size, t_mean, t_scat, h_size, h_mean, h_scat = pieces
     mean, scat = out
     p = mean.shape[0]
-    total = t_size + size * (hi - lo)
+    total = t_size + size * (hi - lo) + h_size
     for a in range(p):
         acc = t_size * t_mean[a] if t_size > 0 else 0.0
         for k in range(lo, hi):
             acc += size * b_mean[k, a]
+        if h_size > 0:
+            acc += h_size * h_mean[a]
         mean[a] = acc / total
     root = math.sqrt(size)
     t_root = math.sqrt(t_size)
+    n_dev = hi - lo + 1
     for a in range(p):
         dev[0, a] = t_root * (t_mean[a] - mean[a]) if t_size > 0 else 0.0
         for k in range(lo, hi):
             dev[k - lo + 1, a] = root * (b_mean[k, a] - mean[a])
-    n_dev = hi - lo + 1
+        if h_size > 0:
+            dev[n_dev, a] = math.sqrt(h_size) * (h_mean[a] - mean[a])
+    if h_size > 0:
+        n_dev += 1
     for a in range(p):
         for b in range(a + 1):
             acc = t_scat[a, b] if t_size > 0 else 0.0
             for k in range(lo, hi):
                 acc += b_scat[k, a, b]
+            if h_size > 0:
+                acc += h_scat[a, b]
             for k in range(n_dev):
                 acc += dev[k, a] * dev[k, b]
             scat[a, b] = acc
@@ -347,16 +363,18 @@ def solve_windows(
     """
     j0, count = windows
     n_eq, p = plan.chan.shape
-    window, cluster = plan.window, plan.cluster
+    window, cluster, size = plan.window, plan.cluster, plan.block
     first = -first_row
-    b_lo = max(0, cluster * j0 - window) // cluster  # the block holding the first start
-    n_blocks = j0 + count - 1 - b_lo  # block j - 1 is the newest of window j
+    b_lo = -(-max(0, cluster * j0 - window) // size)  # the first full block of any window
+    n_blocks = max(0, cluster * (j0 + count - 1) // size - b_lo)
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
     b_step = np.empty(n_blocks)
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
-    dev = np.empty((window // cluster + 2, p))
+    h_mean = np.empty(p)
+    h_scat = np.empty((p, p))
+    dev = np.empty((window // size + 3, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
     z = np.empty(p)
@@ -365,9 +383,9 @@ def solve_windows(
         chan = plan.chan[eq]
         lag = plan.lag[eq]
         for b in range(n_blocks):
-            lo = (b_lo + b) * cluster
-            piece_stats(samples, chan, lag, first, (lo, lo + cluster), z, (b_mean[b], b_scat[b]))
-            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + cluster))
+            lo = (b_lo + b) * size
+            piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
+            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + size))
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -386,19 +404,25 @@ def solve_windows(
                 out.degenerate[w, eq] = True
                 out.excited[w, eq] = False
                 continue
-            full_lo = -(-start // cluster)
-            t_size = full_lo * cluster - start  # the tail of the block holding start
+            # rows [start, e) = tail [start, full_lo B) + blocks + head [full_hi B, e)
+            full_lo = -(-start // size)
+            full_hi = max(e // size, full_lo)
+            t_end = min(full_lo * size, e)
+            h_start = min(max(full_hi * size, t_end), e)
+            t_size = t_end - start
+            h_size = e - h_start
             if t_size > 0:
-                piece_stats(
-                    samples, chan, lag, first, (start, full_lo * cluster), z, (t_mean, t_scat)
-                )
+                piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
+            if h_size > 0:
+                piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
             # the output's quantization step in the window (column 0 is y(n))
-            step = piece_step(samples, chan[0], first, (start, full_lo * cluster))
-            for b in range(full_lo - b_lo, j - b_lo):
+            step = piece_step(samples, chan[0], first, (start, t_end))
+            step = min(step, piece_step(samples, chan[0], first, (h_start, e)))
+            for b in range(full_lo - b_lo, full_hi - b_lo):
                 step = min(step, b_step[b])
             n_w = merge(
-                (b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster),
-                (t_size, t_mean, t_scat),
+                (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
+                (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
                 dev,
                 (mean, scat),
             )
@@ -599,9 +623,27 @@ def window_plan(
     transform = np.eye(p) if noise is None else fixed_transform(noise, p)
     window, cluster, min_rows = sizes
     plan = WindowPlan(
-        chan, lag, col_channel, np.ascontiguousarray(transform), window, cluster, min_rows
+        chan,
+        lag,
+        col_channel,
+        np.ascontiguousarray(transform),
+        window,
+        cluster,
+        min_rows,
+        block_rows(window, cluster),
     )
     return plan, n_blocks + 1
+
+
+def block_rows(window: int, cluster: int) -> int:
+    """Rows ``B`` of a block: ``C``, or a multiple of it near ``sqrt(W)`` when ``C`` is small.
+
+    A window costs its tail and head pieces (up to ``B`` rows each, summarised per window)
+    plus a merge over its ``W / B`` full blocks; ``B ~ sqrt(W)`` balances the two. With
+    ``C >= sqrt(W) / 1.5`` (the paper's ``C = 12``, ``W = 201``) ``B = C`` and windows have
+    no head piece.
+    """
+    return cluster * max(1, round(math.sqrt(window) / cluster))
 
 
 def settings_for(
