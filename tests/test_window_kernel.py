@@ -338,3 +338,14 @@ def test_batch_lpc_flags_an_input_relation_solution_like_the_kernel():
 def test_robust_rule_refuses_a_zero_a0_threshold():
     with pytest.raises(ValueError, match=r"min_a0_weight must be a number in \(0, 1\]"):
         clpc.RobustRule(min_a0_weight=0.0)
+
+
+def test_trace_of_needs_every_field_and_equals_the_dataclass_init():
+    u, y = _record(400, seed=6)
+    trace = CLPC(order=2, window_size=60, cluster_size=12).run(u, y)
+    values = {name: getattr(trace, name) for name in trace.__dataclass_fields__}
+    again = Trace.of(values)
+    assert again.__dict__ == trace.__dict__ and len(again) == len(trace)
+    del values["meta"]
+    with pytest.raises(TypeError, match="meta"):
+        Trace.of(values)

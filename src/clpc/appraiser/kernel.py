@@ -76,12 +76,12 @@ __all__ = [
     "WindowPlan",
     "batches",
     "fsm_output",
-    "output",
+    "outputs",
     "record_setup",
     "settings_for",
-    "solve",
     "solve_updates",
     "update",
+    "update_one",
     "window_plan",
 ]
 
@@ -662,9 +662,13 @@ def settings_for(
     return solve_settings(rule, name == "robust", mode, na + 1, n_channels)
 
 
+#: a kernel call's outputs as plain tuples, in the fields' order of Solved and FsmOutput
+Plain = tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]
+
+
 def update(
     samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: KernelSetup, state: FsmState
-) -> tuple[Solved, FsmOutput]:
+) -> Plain:
     """Solve ``windows`` and run the FSM output over them in one kernel call.
 
     Parameters
@@ -681,62 +685,44 @@ def update(
 
     Returns
     -------
-    solved : Solved
-    output : FsmOutput
+    solved, output : tuple of ndarray
+        The fields of :class:`Solved` and of :class:`FsmOutput`, in order (plain tuples:
+        the hot path of ``step`` builds no named tuples).
     """
-    solved = _solved(windows[1], setup.plan)
-    out = _fsm_output(solved, setup.fsm, setup.n_inputs)
-    update_windows(
-        samples[0], samples[1], windows, setup.plain, tuple(state), (tuple(solved), tuple(out))
-    )
+    solved, out = outputs(windows[1], setup)
+    update_windows(samples[0], samples[1], windows, setup.plain, tuple(state), (solved, out))
     return solved, out
 
 
-def solve(
-    samples: np.ndarray,
-    first_row: int,
-    windows: tuple[int, int],
-    plan: WindowPlan,
-    settings: SolveSettings,
-) -> Solved:
-    """Solve ``windows = (j0, count)`` (see :func:`solve_windows`)."""
-    out = _solved(windows[1], plan)
-    solve_windows(samples, first_row, windows, plan, settings, out)
-    return out
+def update_one(
+    setup: KernelSetup, samples: tuple[np.ndarray, int], j: int, state: FsmState
+) -> dict[str, np.ndarray]:
+    """Update ``j`` alone (:func:`update` with one window): the arrays of its trace row.
+
+    The streaming path (``step``, small ``push`` chunks): one kernel call, no batching.
+    Returns the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION` plus
+    ``not_enough`` and ``n_rows``, each with one row.
+    """
+    return _arrays(*update(samples, (j, 1), setup, state))
 
 
-def output(solved: Solved, fs: FsmSettings, state: FsmState, n_inputs: int) -> FsmOutput:
-    """The FSM output of ``solved`` (``state`` is updated in place)."""
-    out = _fsm_output(solved, fs, n_inputs)
-    fsm_output(solved, fs, state, out)
-    return out
+def outputs(count: int, setup: KernelSetup) -> Plain:
+    """Uninitialised output arrays of ``count`` updates, as plain tuples (see :data:`Plain`).
 
-
-def _solved(count: int, plan: WindowPlan) -> Solved:
-    e, p = plan.chan.shape
-    f = np.empty((2, count, e, p))  # same-shape fields share one allocation (hot path)
-    g = np.empty((4, count, e))
+    Fields of the same shape and type share one allocation (a call of ``step`` allocates
+    them all for one update: their number is most of its cost).
+    """
+    e, p = setup.plan.chan.shape
+    fs = setup.fsm
+    f = np.empty((3, count, e, p))
+    g = np.empty((10, count, e))
     i = np.empty((2, count, e), np.int64)
-    b = np.empty((2, count, e), np.bool_)
-    fields = (*f, *g, *i, *b, np.empty(count, np.int64))
-    return Solved(*fields)
-
-
-def _fsm_output(solved: Solved, fs: FsmSettings, n_inputs: int) -> FsmOutput:
-    count, e, p = solved.theta.shape
-    b = np.empty((5, count, e), np.bool_)
-    g = np.empty((5, count, e))
-    fields = (
-        np.empty((count, e, p)),
-        np.empty((count, e)),
-        *b[:4],
-        np.empty(count, np.bool_),
-        np.empty((count, e, fs.na + 1)),
-        np.empty((count, e, n_inputs, fs.nk + fs.nb + 1)),
-        b[4],
-        *g,
-    )
-    return FsmOutput(*fields)
+    b = np.empty((7, count, e), np.bool_)
+    solved = (f[0], f[1], g[0], g[1], g[2], g[3], i[0], i[1], b[0], b[1])
+    den = np.empty((count, e, fs.na + 1))
+    num = np.empty((count, e, setup.n_inputs, fs.nk + fs.nb + 1))
+    out = (f[2], g[4], b[2], b[3], b[4], b[5], np.empty(count, np.bool_), den, num, b[6])
+    return (*solved, np.empty(count, np.int64)), (*out, g[5], g[6], g[7], g[8], g[9])
 
 
 def batches(j_first: int, j_last: int, n_jobs: int) -> list[tuple[int, int]]:
@@ -782,43 +768,39 @@ def solve_updates(
     if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
         run = update
         return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
+    allocated = [outputs(count, setup) for _, count in parts]
 
-    def solve_batch(batch: tuple[int, int]) -> Solved:
-        return solve(buf, first_row, batch, setup.plan, setup.settings)
+    def solve_batch(k: int) -> None:
+        solved = Solved(*allocated[k][0])
+        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, solved)
 
-    solved = list(mapper(solve_batch, parts))  # windows are independent: threads
-    return [  # the FSM output runs in time order
-        (j0, count, _arrays(sol, output(sol, setup.fsm, state, setup.n_inputs)))
-        for (j0, count), sol in zip(parts, solved, strict=True)
-    ]
+    list(mapper(solve_batch, range(len(parts))))  # windows are independent: threads
+    for solved, out in allocated:  # the FSM output runs in time order
+        fsm_output(Solved(*solved), setup.fsm, state, FsmOutput(*out))
+    return [(j0, c, _arrays(*plain)) for (j0, c), plain in zip(parts, allocated, strict=True)]
 
 
-def _arrays(sol: Solved, fsm: FsmOutput) -> dict[str, np.ndarray]:
-    """The per-update arrays of a trace part, from the kernel's two outputs."""
-    return {
-        "theta": fsm.theta,
-        "c": fsm.c,
-        "accepted": fsm.accepted,
-        "has_model": fsm.has_model,
-        "determined": fsm.determined,
-        "trusted": fsm.trusted,
-        "not_enough": fsm.not_enough,
-        "den": fsm.den,
-        "num": fsm.num,
-        "stable": fsm.stable,
-        "lambda_min": fsm.lambda_min,
-        "lambda_max": fsm.lambda_max,
-        "D": fsm.D,
-        "eig_ratio": fsm.eig_ratio,
-        "J": fsm.J,
-        "theta_estimate": sol.theta,
-        "eigenvalues": sol.eigenvalues,
-        "separation": sol.separation,
-        "a0_weight": sol.a0_weight,
-        "noise_variance": sol.noise_variance,
-        "n_null": sol.n_null,
-        "n_input_relations": sol.n_input_relations,
-        "degenerate": sol.degenerate,
-        "excited": sol.excited,
-        "n_rows": sol.n_rows,
-    }
+#: trace keys of the fields of Solved (None: not in the trace) and of FsmOutput
+_SOLVED_KEYS = (
+    "theta_estimate",
+    "eigenvalues",
+    None,
+    "noise_variance",
+    "separation",
+    "a0_weight",
+    "n_null",
+    "n_input_relations",
+    "degenerate",
+    "excited",
+    "n_rows",
+)
+_FSM_KEYS = tuple(FsmOutput._fields)
+
+
+def _arrays(solved: tuple[np.ndarray, ...], out: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """The per-update arrays of a trace part, from the kernel's two outputs (plain tuples)."""
+    arrays = dict(zip(_FSM_KEYS, out, strict=True))
+    for key, value in zip(_SOLVED_KEYS, solved, strict=True):
+        if key is not None:
+            arrays[key] = value
+    return arrays

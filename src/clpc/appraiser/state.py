@@ -211,8 +211,14 @@ class AppraiserState:
         self.n_seen += new.shape[0]
         c, w, max_lag = self.cluster, self.settings.window_size, self.max_lag
         j_last = max(self.n_seen - max_lag, 0) // c
-        trace = self.empty_trace()
-        if j_last > self.j_done:
+        if j_last == self.j_done + 1:  # one update (step, small pushes): no batching
+            state = kernel.FsmState(self.last_theta, self.last_c, self.has_model)
+            samples = (buf.data, buf.start - max_lag)
+            arrays = kernel.update_one(self.setup or self.kernel_setup(), samples, j_last, state)
+            index = np.array([max_lag + c * j_last - 1])
+            trace = (self.labels or self.trace_labels()).trace(index, arrays.pop("n_rows"), arrays)
+            self.j_done = j_last
+        elif j_last > self.j_done:
             state = kernel.FsmState(self.last_theta, self.last_c, self.has_model)
             parts = kernel.solve_updates(
                 self.kernel_setup(),
@@ -228,6 +234,8 @@ class AppraiserState:
                 traces.append(labels.trace(index, arrays.pop("n_rows"), arrays))
             trace = traces[0] if len(traces) == 1 else Trace.concat(traces)
             self.j_done = j_last
+        else:
+            trace = self.empty_trace()
         # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
         buf.drop_before(max(0, c * (self.j_done + 1) - w - c))
         return trace
