@@ -349,3 +349,16 @@ def test_trace_of_needs_every_field_and_equals_the_dataclass_init():
     del values["meta"]
     with pytest.raises(TypeError, match="meta"):
         Trace.of(values)
+
+
+def test_trace_view_shares_rows_and_allocate_copies_meta():
+    u, y = _record(400, seed=6)
+    trace = CLPC(order=2, window_size=60, cluster_size=12).run(u, y)
+    part = trace.view(3, 7)
+    assert len(part) == 4
+    np.testing.assert_array_equal(part.theta, trace.theta[3:7])
+    part.arrays["D"][0, 0] = -1.0  # a view: writing it writes the trace
+    assert trace.arrays["D"][3, 0] == -1.0
+    fresh = Trace.allocate(trace, 5)
+    fresh.meta["mark"] = 1
+    assert "mark" not in trace.meta and len(fresh) == 5

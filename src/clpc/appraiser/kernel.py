@@ -80,6 +80,7 @@ __all__ = [
     "record_setup",
     "settings_for",
     "solve_updates",
+    "trace_outputs",
     "update",
     "update_one",
     "window_plan",
@@ -740,8 +741,9 @@ def solve_updates(
     samples: tuple[np.ndarray, int],
     updates: tuple[int, int],
     state: FsmState,
+    dest: Plain,
     threads: tuple[int, Callable[..., Any]] = (1, map),
-) -> list[tuple[int, int, dict[str, np.ndarray]]]:
+) -> None:
     """Solve updates ``updates = (j_first, j_last)`` and run the FSM output over them.
 
     Parameters
@@ -753,31 +755,50 @@ def solve_updates(
     updates : (j_first, j_last)
     state : FsmState
         The carried FSM state, updated in place.
+    dest : Plain
+        Where the outputs go, one row per update (e.g. :func:`outputs`, or
+        :func:`trace_outputs` to write straight into a trace); each batch writes its rows.
     threads : (n_jobs, map)
         Thread count and ``map`` or a thread pool's ``map`` (batches are independent).
-
-    Returns
-    -------
-    list of (j0, count, arrays)
-        Per batch, the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION`
-        plus ``not_enough`` and ``n_rows``.
     """
     buf, first_row = samples
     n_jobs, mapper = threads
-    parts = batches(updates[0], updates[1], n_jobs)
+    j_first = updates[0]
+    parts = batches(j_first, updates[1], n_jobs)
+    views = [_rows(dest, j0 - j_first, j0 - j_first + c) for j0, c in parts]
     if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
-        run = update
-        return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
-    allocated = [outputs(count, setup) for _, count in parts]
+        for batch, (solved, out) in zip(parts, views, strict=True):
+            update_windows(buf, first_row, batch, setup.plain, tuple(state), (solved, out))
+        return
 
-    def solve_batch(k: int) -> None:
-        solved = Solved(*allocated[k][0])
-        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, solved)
+    def solve_batch(k: int) -> int:
+        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, Solved(*views[k][0]))
+        return k
 
-    list(mapper(solve_batch, range(len(parts))))  # windows are independent: threads
-    for solved, out in allocated:  # the FSM output runs in time order
-        fsm_output(Solved(*solved), setup.fsm, state, FsmOutput(*out))
-    return [(j0, c, _arrays(*plain)) for (j0, c), plain in zip(parts, allocated, strict=True)]
+    # windows are independent: threads; the FSM output runs in time order, each batch's as
+    # soon as it is solved (while the threads solve the next ones)
+    for k in mapper(solve_batch, range(len(parts))):
+        fsm_output(Solved(*views[k][0]), setup.fsm, state, FsmOutput(*views[k][1]))
+
+
+def trace_outputs(arrays: dict[str, np.ndarray], rows: np.ndarray, not_enough: np.ndarray) -> Plain:
+    """The kernel's outputs as the arrays of a trace (see :data:`Plain`): no copies.
+
+    ``arrays`` holds the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION`,
+    ``rows`` and ``not_enough`` the rows and flags (all with the same number of rows);
+    the solved ``c`` (not in a trace) gets a scratch array.
+    """
+    scratch = np.empty(arrays["c"].shape)
+    solved = tuple(
+        scratch if key is None else rows if key == "n_rows" else arrays[key] for key in _SOLVED_KEYS
+    )
+    out = tuple(not_enough if key == "not_enough" else arrays[key] for key in _FSM_KEYS)
+    return solved, out
+
+
+def _rows(plain: Plain, lo: int, hi: int) -> Plain:
+    """Rows ``lo .. hi - 1`` of every output (views, C-contiguous)."""
+    return tuple(a[lo:hi] for a in plain[0]), tuple(a[lo:hi] for a in plain[1])
 
 
 #: trace keys of the fields of Solved (None: not in the trace) and of FsmOutput

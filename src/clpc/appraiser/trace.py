@@ -193,9 +193,24 @@ class Trace:
         rest = {
             f.name: getattr(like, f.name)
             for f in fields(cls)
-            if f.name not in plain and f.name != "arrays"
+            if f.name not in plain and f.name not in ("arrays", "meta")
         }
-        return cls(**kw, arrays=arrays, **rest)
+        return cls(**kw, arrays=arrays, meta=dict(like.meta), **rest)
+
+    def view(self, start: int, stop: int) -> Trace:
+        """Rows ``start .. stop - 1`` sharing this trace's memory (writing one writes both).
+
+        Parameters
+        ----------
+        start, stop : int
+            The rows, as in a slice.
+        """
+        rows = slice(start, stop)
+        values = {f: getattr(self, f)[rows] for f in ("index", "time", "rows", "not_enough_data")}
+        values["arrays"] = {k: v[rows] for k, v in self.arrays.items()}
+        for f in _FIELD_NAMES - values.keys():
+            values[f] = getattr(self, f)
+        return Trace.of(values)
 
     def put(self, start: int, part: Trace) -> int:
         """Copy the rows of ``part`` into rows ``start ..``; returns the row after them.
