@@ -9,6 +9,7 @@ CI, once more with ``NUMBA_DISABLE_JIT=1`` (the same functions as plain Python);
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -362,3 +363,22 @@ def test_trace_view_shares_rows_and_allocate_copies_meta():
     fresh = Trace.allocate(trace, 5)
     fresh.meta["mark"] = 1
     assert "mark" not in trace.meta and len(fresh) == 5
+
+
+@pytest.mark.parametrize("cluster", [1, 12])
+def test_block_cache_reuse_is_bit_identical_across_a_saved_state(cluster):
+    # step fills the block cache (statistics of the newest blocks, reused by later
+    # updates); a restored state starts without it and recomputes: the same bits
+    u, y = _record(900, seed=11, offset=50.0)
+    u, y = u[:, 0], y[:, 0]
+    settings = {"order": 2, "window_size": 101, "cluster_size": cluster}
+    batch = CLPC(**settings).run(u, y)
+    a = CLPC(**settings)
+    first = [a.step(float(u[k]), float(y[k])) for k in range(500)]
+    span = a._state.blocks.span.copy()
+    assert span[1] > span[0]  # blocks were kept between the updates
+    b = CLPC.from_state_dict(json.loads(json.dumps(a.state_dict())))
+    rest = [b.step(float(u[k]), float(y[k])) for k in range(500, 900)]
+    stepped = Trace.concat(first + rest)
+    for key in ("theta", "theta_estimate", "eigenvalues", "D", "J", "excited", "accepted"):
+        np.testing.assert_array_equal(stepped.arrays[key], batch.arrays[key], key)

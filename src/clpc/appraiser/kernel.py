@@ -68,6 +68,7 @@ if TYPE_CHECKING:
     from clpc.appraiser.settings import Settings
 
 __all__ = [
+    "BlockCache",
     "FsmOutput",
     "FsmSettings",
     "FsmState",
@@ -75,7 +76,9 @@ __all__ = [
     "Solved",
     "WindowPlan",
     "batches",
+    "cache_blocks",
     "fsm_output",
+    "new_cache",
     "outputs",
     "record_setup",
     "settings_for",
@@ -345,6 +348,78 @@ def solve_one(
     )
 
 
+class BlockCache(NamedTuple):
+    """Statistics of the newest blocks, kept between kernel calls (see :func:`new_cache`).
+
+    A block's statistics are a function of its rows alone, so a block summarised by an
+    earlier call is reused bit for bit: ``step`` then summarises one new block per update
+    instead of the whole window. Blocks ``span[0] .. span[1] - 1`` are held, block ``k``
+    at ring position ``k % M`` (``M`` = the second axis; 0: no cache).
+    """
+
+    mean: np.ndarray  #: (E, M, p)
+    scat: np.ndarray  #: (E, M, p, p)
+    step: np.ndarray  #: (E, M)
+    span: np.ndarray  #: (2,) int64
+
+
+def new_cache(shape: tuple[int, int], ring: int) -> BlockCache:
+    """An empty :class:`BlockCache` of ``ring`` blocks per equation (0: caching off).
+
+    ``shape = (E, p)``: equations and parameters per equation.
+    """
+    n_eq, p = shape
+    return BlockCache(
+        np.zeros((n_eq, ring, p)),
+        np.zeros((n_eq, ring, p, p)),
+        np.zeros((n_eq, ring)),
+        np.zeros(2, np.int64),
+    )
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def gather_blocks(
+    samples: np.ndarray,
+    where: tuple[np.ndarray, np.ndarray, int, int, int, int],
+    cache: tuple[np.ndarray, np.ndarray, np.ndarray, int, int],
+    z: np.ndarray,
+    blocks: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """Statistics of blocks ``b_lo .. b_lo + n - 1`` of one equation, from the cache or rows.
+
+    ``where = (chan, lag, first, b_lo, n, size)``; ``cache = (mean (M, p), scat (M, p, p),
+    step (M,), lo, hi)``: one equation's ring and the blocks it holds; ``blocks = (b_mean,
+    b_scat, b_step)``. The newest ``min(n, M)`` blocks are written back into the ring.
+    """
+    chan, lag, first, b_lo, n, size = where
+    c_mean, c_scat, c_step, c_lo, c_hi = cache
+    b_mean, b_scat, b_step = blocks
+    ring = c_mean.shape[0]
+    p = c_mean.shape[1]
+    for b in range(n):
+        k = b_lo + b
+        if c_lo <= k < c_hi:
+            pos = k % ring
+            for a in range(p):
+                b_mean[b, a] = c_mean[pos, a]
+                for c in range(p):
+                    b_scat[b, a, c] = c_scat[pos, a, c]
+            b_step[b] = c_step[pos]
+        else:
+            lo = k * size
+            piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
+            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + size))
+    if ring == 0:
+        return
+    for b in range(max(0, n - ring), n):
+        pos = (b_lo + b) % ring
+        for a in range(p):
+            c_mean[pos, a] = b_mean[b, a]
+            for c in range(p):
+                c_scat[pos, a, c] = b_scat[b, a, c]
+        c_step[pos] = b_step[b]
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_windows(
     samples: np.ndarray,
@@ -353,6 +428,7 @@ def solve_windows(
     plan: WindowPlan,
     s: SolveSettings,
     out: Solved,
+    cache: BlockCache,
 ) -> None:
     """Solve windows ``j0 .. j0 + count - 1`` (``windows = (j0, count)``) of every equation.
 
@@ -360,7 +436,8 @@ def solve_windows(
     ``samples[r - first_row]``. Windows with fewer than ``plan.min_rows`` rows are not
     solved (their outputs are zero and flagged degenerate). A channel's quantization step
     in a window (for :func:`clpc.core.rules.is_excited`) is its smallest nonzero change
-    between consecutive samples of the window.
+    between consecutive samples of the window. ``cache`` (:class:`BlockCache`) supplies the
+    blocks an earlier call summarised and keeps the newest (updated in place).
     """
     j0, count = windows
     n_eq, p = plan.chan.shape
@@ -380,13 +457,17 @@ def solve_windows(
     scat = np.empty((p, p))
     z = np.empty(p)
     work = new_work(p)
+    c_lo, c_hi = cache.span[0], cache.span[1]
     for eq in range(n_eq):
         chan = plan.chan[eq]
         lag = plan.lag[eq]
-        for b in range(n_blocks):
-            lo = (b_lo + b) * size
-            piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
-            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + size))
+        gather_blocks(
+            samples,
+            (chan, lag, first, b_lo, n_blocks, size),
+            (cache.mean[eq], cache.scat[eq], cache.step[eq], c_lo, c_hi),
+            z,
+            (b_mean, b_scat, b_step),
+        )
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -438,6 +519,9 @@ def solve_windows(
             out.n_input_relations[w, eq] = res[5]
             out.degenerate[w, eq] = res[6]
             out.excited[w, eq] = is_excited(scat, n_w, step, s.n_out_cols)
+    if cache.mean.shape[1] > 0 and n_blocks > 0:
+        cache.span[0] = b_lo + max(0, n_blocks - cache.mean.shape[1])
+        cache.span[1] = b_lo + n_blocks
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -509,20 +593,22 @@ def update_windows(
     settings: tuple[Any, ...],
     state: tuple[Any, ...],
     out: tuple[Any, ...],
+    cache: tuple[np.ndarray, ...],
 ) -> None:
     """:func:`solve_windows` then :func:`fsm_output` in one call (one dispatch per update).
 
     The containers arrive as plain tuples - ``settings = (plan, solve settings, FSM
-    settings)``, ``state``, ``out = (solved, output)`` - in the fields' order of
+    settings)``, ``state``, ``out = (solved, output)``, ``cache`` - in the fields' order of
     :class:`WindowPlan`, :class:`SolveSettings`, :class:`FsmSettings`, :class:`FsmState`,
-    :class:`Solved` and :class:`FsmOutput`: numba types plain tuples of arrays several
-    times faster than named tuples at the call, which is most of the cost of one update.
+    :class:`Solved`, :class:`FsmOutput` and :class:`BlockCache`: numba types plain tuples
+    of arrays several times faster than named tuples at the call, which is most of the cost
+    of one update.
     """
     plan = WindowPlan(*settings[0])
     s = SolveSettings(*settings[1])
     fs = FsmSettings(*settings[2])
     solved = Solved(*out[0])
-    solve_windows(samples, first_row, windows, plan, s, solved)
+    solve_windows(samples, first_row, windows, plan, s, solved, BlockCache(*cache))
     fsm_output(solved, fs, FsmState(*state), FsmOutput(*out[1]))
 
 
@@ -636,6 +722,11 @@ def window_plan(
     return plan, n_blocks + 1
 
 
+def cache_blocks(plan: WindowPlan) -> int:
+    """Blocks a :class:`BlockCache` holds: those of one window, and one more."""
+    return plan.window // plan.block + 2
+
+
 def block_rows(window: int, cluster: int) -> int:
     """Rows ``B`` of a block: ``C``, or a multiple of it near ``sqrt(W)`` when ``C`` is small.
 
@@ -668,7 +759,10 @@ Plain = tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]
 
 
 def update(
-    samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: KernelSetup, state: FsmState
+    samples: tuple[np.ndarray, int],
+    windows: tuple[int, int],
+    setup: KernelSetup,
+    state: tuple[FsmState, BlockCache],
 ) -> Plain:
     """Solve ``windows`` and run the FSM output over them in one kernel call.
 
@@ -681,8 +775,9 @@ def update(
     setup : KernelSetup
         The record's :class:`KernelSetup` (its ``plain`` settings go
         to :func:`update_windows`).
-    state : FsmState
-        The carried :class:`FsmState` (updated in place).
+    state : (FsmState, BlockCache)
+        The carried :class:`FsmState` and the record's :class:`BlockCache` (both updated
+        in place).
 
     Returns
     -------
@@ -691,12 +786,18 @@ def update(
         the hot path of ``step`` builds no named tuples).
     """
     solved, out = outputs(windows[1], setup)
-    update_windows(samples[0], samples[1], windows, setup.plain, tuple(state), (solved, out))
+    fsm, cache = state
+    update_windows(
+        samples[0], samples[1], windows, setup.plain, tuple(fsm), (solved, out), tuple(cache)
+    )
     return solved, out
 
 
 def update_one(
-    setup: KernelSetup, samples: tuple[np.ndarray, int], j: int, state: FsmState
+    setup: KernelSetup,
+    samples: tuple[np.ndarray, int],
+    j: int,
+    state: tuple[FsmState, BlockCache],
 ) -> dict[str, np.ndarray]:
     """Update ``j`` alone (:func:`update` with one window): the arrays of its trace row.
 
@@ -740,7 +841,7 @@ def solve_updates(
     setup: KernelSetup,
     samples: tuple[np.ndarray, int],
     updates: tuple[int, int],
-    state: FsmState,
+    state: tuple[FsmState, BlockCache],
     dest: Plain,
     threads: tuple[int, Callable[..., Any]] = (1, map),
 ) -> None:
@@ -753,8 +854,9 @@ def solve_updates(
         Buffered samples (n, channels) and the absolute lag row of ``buffer[0]`` minus
         ``max_lag`` (see :func:`solve_windows`).
     updates : (j_first, j_last)
-    state : FsmState
-        The carried FSM state, updated in place.
+    state : (FsmState, BlockCache)
+        The carried FSM state and the record's block cache, updated in place (the threads
+        use no cache: their batches run at once).
     dest : Plain
         Where the outputs go, one row per update (e.g. :func:`outputs`, or
         :func:`trace_outputs` to write straight into a trace); each batch writes its rows.
@@ -763,22 +865,28 @@ def solve_updates(
     """
     buf, first_row = samples
     n_jobs, mapper = threads
+    fsm, cache = state
     j_first = updates[0]
     parts = batches(j_first, updates[1], n_jobs)
     views = [_rows(dest, j0 - j_first, j0 - j_first + c) for j0, c in parts]
     if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
+        plain_state, plain_cache = tuple(fsm), tuple(cache)
         for batch, (solved, out) in zip(parts, views, strict=True):
-            update_windows(buf, first_row, batch, setup.plain, tuple(state), (solved, out))
+            update_windows(
+                buf, first_row, batch, setup.plain, plain_state, (solved, out), plain_cache
+            )
         return
+    off = new_cache(setup.plan.chan.shape, 0)
 
     def solve_batch(k: int) -> int:
-        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, Solved(*views[k][0]))
+        solved = Solved(*views[k][0])
+        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, solved, off)
         return k
 
     # windows are independent: threads; the FSM output runs in time order, each batch's as
     # soon as it is solved (while the threads solve the next ones)
     for k in mapper(solve_batch, range(len(parts))):
-        fsm_output(Solved(*views[k][0]), setup.fsm, state, FsmOutput(*views[k][1]))
+        fsm_output(Solved(*views[k][0]), setup.fsm, fsm, FsmOutput(*views[k][1]))
 
 
 def trace_outputs(arrays: dict[str, np.ndarray], rows: np.ndarray, not_enough: np.ndarray) -> Plain:

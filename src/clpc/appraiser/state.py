@@ -67,6 +67,7 @@ class AppraiserState:
     setup: kernel.KernelSetup | None = None
     labels: TraceLabels | None = None
     empty: Trace | None = None
+    blocks: kernel.BlockCache | None = None  #: statistics of the newest blocks (derived)
 
     def __post_init__(self) -> None:
         self.max_lag = self.settings.structure.max_lag
@@ -239,10 +240,14 @@ class AppraiserState:
         self.n_seen += new.shape[0]
         return max(self.n_seen - self.max_lag, 0) // self.cluster - self.j_done
 
-    def _fsm_state(self) -> kernel.FsmState:
+    def _fsm_state(self) -> tuple[kernel.FsmState, kernel.BlockCache]:
+        """The carried FSM state and the block cache (made on first use; never saved)."""
         assert self.last_theta is not None and self.last_c is not None
         assert self.has_model is not None
-        return kernel.FsmState(self.last_theta, self.last_c, self.has_model)
+        if self.blocks is None:
+            plan = self.kernel_setup().plan
+            self.blocks = kernel.new_cache(plan.chan.shape, kernel.cache_blocks(plan))
+        return kernel.FsmState(self.last_theta, self.last_c, self.has_model), self.blocks
 
     def _one_update(self) -> Trace:
         """The next update alone, as a new trace (the lean path of ``step``)."""
