@@ -327,7 +327,7 @@ def table(args: Any) -> str:
 def add_arguments(ap: Any) -> None:
     """The table's options (shared with ``bench_clpc.py --table``)."""
     ap.add_argument("--table-samples", dest="samples", type=float, default=1e5)
-    ap.add_argument("--repeat", type=int, default=5, help="best of this many (default 5)")
+    ap.add_argument("--table-repeat", dest="repeat", type=int, default=5, help="best of (5)")
     ap.add_argument("--ref-windows", type=int, default=1000, help="reference prefix (1000)")
     ap.add_argument("--peer-windows", type=int, default=100, help="windows per peer (100)")
     ap.add_argument(
