@@ -361,6 +361,10 @@ def test_to_frame_columns():
         ({"decimate_to": -1.0}, "decimate_to must be > 0"),
         ({"method": "lsq"}, "method must be"),
         ({"min_rows": 1}, "min_rows must be an int"),
+        # None is "the default" only for the optional counts (a saved state may carry it)
+        ({"n_jobs": None}, "n_jobs must be an int"),
+        ({"chunk_samples": None}, "chunk_samples must be an int"),
+        ({"window_size": None}, "window_size must be an int"),
     ],
 )
 def test_constructor_validation(kwargs, match):
