@@ -70,6 +70,8 @@ Usage::
     python benchmarks/bench_clpc.py --profile --sizes 1e6      # cProfile of run and step
     python benchmarks/bench_clpc.py --sizes 1e4 1e5 1e6
     python benchmarks/bench_clpc.py --huge     # adds a 1e8-sample record streamed from .npy
+    python benchmarks/bench_clpc.py --table    # issue 26's table (clpc_table.py), peers too
+    python benchmarks/bench_clpc.py --split    # per-window cost split (clpc_split.py)
 """
 
 from __future__ import annotations
@@ -89,6 +91,9 @@ from pathlib import Path
 
 import numpy as np
 from scipy import signal
+
+sys.path.insert(0, str(Path(__file__).parent))
+import clpc_table  # numpy and scipy only at import (clpc is imported when measured)
 
 ORDER, WINDOW, CLUSTER = 2, 201, 12
 DEN = np.array([1.0, -1.5, 0.7])
@@ -623,6 +628,18 @@ def main(argv: list[str] | None = None) -> int:
         help="rounds of the new vs baseline measurements, each a worker per package, their "
         "order alternating; the best of each package is kept (default 3)",
     )
+    ap.add_argument(
+        "--table",
+        action="store_true",
+        help="only issue 26's table (benchmarks/clpc_table.py: every configuration, the "
+        "reference and the peers in one run)",
+    )
+    ap.add_argument(
+        "--split",
+        action="store_true",
+        help="only the per-window cost split of the kernel (benchmarks/clpc_split.py)",
+    )
+    clpc_table.add_arguments(ap)
     ap.add_argument("--workdir", default=None, help="where the data files go (default: temp)")
     ap.add_argument("--keep-data", action="store_true", help="keep the data files (--workdir)")
     ap.add_argument("--worker", default=None, help=argparse.SUPPRESS)
@@ -631,6 +648,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dump-worker", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
 
+    if args.table:
+        if args.peers_python and not Path(args.peers_python).exists():
+            args.peers_python = ""
+        print(clpc_table.table(args))
+        return 0
+    if args.split:
+        import clpc_split  # compiles its harness on import
+
+        clpc_split.main()
+        return 0
     if args.worker:
         spec = json.loads(args.worker)
         if "multi" in spec:  # several measurements, one after the other, in this process

@@ -326,11 +326,21 @@ def test_decimation_by_sample_time():
         )
 
 
-def test_threads_give_the_same_result():
+@pytest.mark.parametrize(("cluster", "chunk"), [(12, 65536), (12, 5000), (1, 3000)])
+def test_threads_give_the_same_result(cluster, chunk):
+    # several chunks and batches per chunk: every array, bit for bit, run and push
     u, y = record(20000, seed=12, noise=0.01)
-    one = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
-    two = CLPC(order=2, window_size=201, cluster_size=12, n_jobs=2).run(u, y)
-    np.testing.assert_array_equal(one.theta, two.theta)
+    settings = {"order": 2, "window_size": 201, "cluster_size": cluster, "chunk_samples": chunk}
+    one = CLPC(**settings).run(u, y)
+    two = CLPC(**settings, n_jobs=2).run(u, y)
+    pushed = CLPC(**settings, n_jobs=2)
+    parts = Trace.concat([pushed.push(u[i : i + 7000], y[i : i + 7000]) for i in (0, 7000, 14000)])
+    for other in (two, parts):
+        assert other.arrays.keys() == one.arrays.keys()
+        for key in one.arrays:
+            np.testing.assert_array_equal(other.arrays[key], one.arrays[key], key)
+        for key in ("index", "time", "rows", "not_enough_data"):
+            np.testing.assert_array_equal(getattr(other, key), getattr(one, key), key)
 
 
 def test_to_frame_columns():
@@ -351,6 +361,10 @@ def test_to_frame_columns():
         ({"decimate_to": -1.0}, "decimate_to must be > 0"),
         ({"method": "lsq"}, "method must be"),
         ({"min_rows": 1}, "min_rows must be an int"),
+        # None is "the default" only for the optional counts (a saved state may carry it)
+        ({"n_jobs": None}, "n_jobs must be an int"),
+        ({"chunk_samples": None}, "chunk_samples must be an int"),
+        ({"window_size": None}, "window_size must be an int"),
     ],
 )
 def test_constructor_validation(kwargs, match):

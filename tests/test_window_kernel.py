@@ -9,6 +9,7 @@ CI, once more with ``NUMBA_DISABLE_JIT=1`` (the same functions as plain Python);
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -120,6 +121,10 @@ PARITY_CASES = [
     ({"cluster_size": 1, "window_size": 40}, 1, 1),
     ({"mimo": "miso"}, 2, 2),
     ({"mimo": "paired", "method": "paper"}, 2, 2),
+    # blocks of B > C rows (kernel.block_rows): tail, full blocks and a head piece
+    ({"cluster_size": 1}, 1, 1),
+    ({"cluster_size": 5, "method": "paper"}, 1, 1),
+    ({"mimo": "miso", "cluster_size": 3, "window_size": 90}, 2, 2),
 ]
 
 
@@ -234,13 +239,23 @@ def test_kernel_agrees_with_reference_on_poorly_excited_and_degenerate_windows(k
         assert fast.degenerate.all() and not fast.has_model.any()
 
 
-def test_compiled_stream_and_step_are_bit_identical_to_run():
+def test_block_rows_balance_pieces_and_merge():
+    assert kernel.block_rows(201, 12) == 12  # the paper's settings: B = C, no head piece
+    assert kernel.block_rows(201, 1) == 14
+    assert kernel.block_rows(201, 5) == 15
+    assert kernel.block_rows(40, 1) == 6
+    assert kernel.block_rows(10, 12) == 12
+
+
+@pytest.mark.parametrize(("window", "cluster"), [(201, 12), (201, 1), (150, 4)])
+def test_compiled_stream_and_step_are_bit_identical_to_run(window, cluster):
     u, y = _record(2000, seed=9, offset=1e4)
     u, y = u[:, 0], y[:, 0]
-    batch = CLPC(order=2, window_size=201, cluster_size=12).run(u, y)
-    a = CLPC(order=2, window_size=201, cluster_size=12)
+    settings = {"order": 2, "window_size": window, "cluster_size": cluster}
+    batch = CLPC(**settings).run(u, y)
+    a = CLPC(**settings)
     pushed = Trace.concat([a.push(u[i : i + 97], y[i : i + 97]) for i in range(0, 2000, 97)])
-    b = CLPC(order=2, window_size=201, cluster_size=12)
+    b = CLPC(**settings)
     # python and numpy scalars take the light path, arrays the general one
     feeds = [float, np.float64, lambda v: np.array([v])]
     stepped = [b.step(feeds[k % 3](u[k]), feeds[k % 3](y[k])) for k in range(2000)]
@@ -248,7 +263,7 @@ def test_compiled_stream_and_step_are_bit_identical_to_run():
     for key in ("theta", "D", "eigenvalues", "c", "den", "J"):
         np.testing.assert_array_equal(pushed.arrays[key], batch.arrays[key], key)
         np.testing.assert_array_equal(stepped.arrays[key], batch.arrays[key], key)
-    assert b.counter == a.counter == (2000 - 2) % 12
+    assert b.counter == a.counter == (2000 - 2) % cluster
 
 
 def test_step_with_integer_and_float32_samples():
@@ -324,3 +339,46 @@ def test_batch_lpc_flags_an_input_relation_solution_like_the_kernel():
 def test_robust_rule_refuses_a_zero_a0_threshold():
     with pytest.raises(ValueError, match=r"min_a0_weight must be a number in \(0, 1\]"):
         clpc.RobustRule(min_a0_weight=0.0)
+
+
+def test_trace_of_needs_every_field_and_equals_the_dataclass_init():
+    u, y = _record(400, seed=6)
+    trace = CLPC(order=2, window_size=60, cluster_size=12).run(u, y)
+    values = {name: getattr(trace, name) for name in trace.__dataclass_fields__}
+    again = Trace.of(values)
+    assert again.__dict__ == trace.__dict__ and len(again) == len(trace)
+    del values["meta"]
+    with pytest.raises(TypeError, match="meta"):
+        Trace.of(values)
+
+
+def test_trace_view_shares_rows_and_allocate_copies_meta():
+    u, y = _record(400, seed=6)
+    trace = CLPC(order=2, window_size=60, cluster_size=12).run(u, y)
+    part = trace.view(3, 7)
+    assert len(part) == 4
+    np.testing.assert_array_equal(part.theta, trace.theta[3:7])
+    part.arrays["D"][0, 0] = -1.0  # a view: writing it writes the trace
+    assert trace.arrays["D"][3, 0] == -1.0
+    fresh = Trace.allocate(trace, 5)
+    fresh.meta["mark"] = 1
+    assert "mark" not in trace.meta and len(fresh) == 5
+
+
+@pytest.mark.parametrize("cluster", [1, 12])
+def test_block_cache_reuse_is_bit_identical_across_a_saved_state(cluster):
+    # step fills the block cache (statistics of the newest blocks, reused by later
+    # updates); a restored state starts without it and recomputes: the same bits
+    u, y = _record(900, seed=11, offset=50.0)
+    u, y = u[:, 0], y[:, 0]
+    settings = {"order": 2, "window_size": 101, "cluster_size": cluster}
+    batch = CLPC(**settings).run(u, y)
+    a = CLPC(**settings)
+    first = [a.step(float(u[k]), float(y[k])) for k in range(500)]
+    span = a._state.blocks.span.copy()
+    assert span[1] > span[0]  # blocks were kept between the updates
+    b = CLPC.from_state_dict(json.loads(json.dumps(a.state_dict())))
+    rest = [b.step(float(u[k]), float(y[k])) for k in range(500, 900)]
+    stepped = Trace.concat(first + rest)
+    for key in ("theta", "theta_estimate", "eigenvalues", "D", "J", "excited", "accepted"):
+        np.testing.assert_array_equal(stepped.arrays[key], batch.arrays[key], key)

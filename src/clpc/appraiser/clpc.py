@@ -18,7 +18,14 @@ from typing import Any
 import numpy as np
 
 from clpc.appraiser.decimation import Decimator
-from clpc.appraiser.inputs import SCALAR_TYPES, as_chunk, as_columns, as_record, check_finite
+from clpc.appraiser.inputs import (
+    SCALAR_TYPES,
+    as_chunk,
+    as_columns,
+    as_record,
+    check_chunk,
+    check_finite,
+)
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.state import AppraiserState
@@ -237,8 +244,14 @@ class CLPC:
             The updates of this chunk (possibly none): consecutive pushes concatenated equal
             :meth:`run` on the whole record.
         """
+        return self._feed(as_chunk(u, y, self._state.n_seen), progress)
+
+    def _feed(
+        self, chunk: tuple[np.ndarray, np.ndarray], progress: Callable[[int, int, int], Any] | None
+    ) -> Trace:
+        """:meth:`push` of a chunk already checked by :func:`as_chunk` (or :func:`check_chunk`)."""
         s = self._state
-        u2, y2 = as_chunk(u, y, s.n_seen)
+        u2, y2 = chunk
         n = u2.shape[0]
         s.init_channels(u2.shape[1], y2.shape[1])
         if s.decimator is None:
@@ -246,14 +259,16 @@ class CLPC:
         decimator = s.decimator
         assert decimator is not None
         total = s.updates_after(n)
-        # the parts are written into the final arrays (no concatenation at the end)
+        # the kernel writes the updates straight into the final arrays (no copies)
         out = Trace.allocate(s.empty_trace(), total) if total else s.empty_trace()
         done, step = 0, self.settings.chunk_samples
         for lo in range(0, n, step):  # bounded working memory
             hi = lo + step
-            part = s.consume(decimator(np.hstack([u2[lo:hi], y2[lo:hi]])), self._map)
+            block = decimator(np.hstack([u2[lo:hi], y2[lo:hi]]))
             if total:
-                done = out.put(done, part)
+                done = s.consume_into(block, self._map, out, done)
+            else:
+                s.consume(block, self._map)  # no update: the samples are only kept
             _LOG.debug("CLPC: %d of %d samples, %d updates", min(hi, n), n, done)
             if progress is not None:
                 progress(min(hi, n), n, done)
@@ -295,7 +310,8 @@ class CLPC:
         s.set_decimator(Decimator(factor))
         if self.decimate_to is None and data_dt is not None:
             s.record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        trace = self.push(u_arr, y_arr, progress=progress)
+        # as_record made them float columns (as push would): only length and finiteness left
+        trace = self._feed(check_chunk(u_arr, y_arr, 0), progress)
         attach_levels(trace, y_arr, factor)  # the windows' levels (steady state)
         return trace
 

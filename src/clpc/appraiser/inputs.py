@@ -15,6 +15,7 @@ __all__ = [
     "as_chunk",
     "as_columns",
     "as_record",
+    "check_chunk",
     "check_finite",
     "check_noise_cov",
 ]
@@ -86,7 +87,11 @@ def check_finite(arr: np.ndarray, name: str, offset: int) -> None:
 
 def as_chunk(u: Any, y: Any, offset: int) -> tuple[np.ndarray, np.ndarray]:
     """A chunk of samples as columns of the same length, finite (``offset``: samples before)."""
-    u2, y2 = as_columns(u, "u"), as_columns(y, "y")
+    return check_chunk(as_columns(u, "u"), as_columns(y, "y"), offset)
+
+
+def check_chunk(u2: np.ndarray, y2: np.ndarray, offset: int) -> tuple[np.ndarray, np.ndarray]:
+    """Columns from :func:`as_columns` of the same length and finite; returns them."""
     if u2.shape[0] != y2.shape[0]:
         raise DataError(
             f"u and y must have the same length; got len(u)={u2.shape[0]}, len(y)={y2.shape[0]}."

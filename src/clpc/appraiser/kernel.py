@@ -13,10 +13,15 @@ A window's numbers depend only on its own rows, never on how a record was chunke
 
 Windows (section V; ``docs/clpc.md``): update ``j`` closes after lag row ``e = C j`` and
 uses rows ``[s, e)``, ``s = max(0, e - W)``: the window grows until it holds ``W`` rows,
-then slides. Cut the lag rows into blocks ``[l C, (l + 1) C)``; a window is::
+then slides. Cut the lag rows into blocks ``[l B, (l + 1) B)`` of ``B`` rows, a multiple
+of ``C`` (:func:`block_rows`: ``B = C`` unless ``C`` is small against ``sqrt(W)``); a
+window is::
 
-    tail of the block holding s (its last rows)  +  the full blocks up to e
-    \____________ computed per window _________/    \___ once per block __/
+    tail: rows of s's block  +  the full blocks  +  head: rows of e's block before e
+    \_ computed per window _/    \_ once per block _/   \_____ computed per window ____/
+
+(with ``B = C`` the head is empty). The blocks are aligned to absolute row numbers, so
+the pieces of a window do not depend on how the record was chunked either.
 
 Each piece is summarised by its count, mean and centered scatter (two-pass), and pieces
 are merged with the formula of Chan, Golub and LeVeque::
@@ -63,6 +68,7 @@ if TYPE_CHECKING:
     from clpc.appraiser.settings import Settings
 
 __all__ = [
+    "BlockCache",
     "FsmOutput",
     "FsmSettings",
     "FsmState",
@@ -70,13 +76,16 @@ __all__ = [
     "Solved",
     "WindowPlan",
     "batches",
+    "cache_blocks",
     "fsm_output",
-    "output",
+    "new_cache",
+    "outputs",
     "record_setup",
     "settings_for",
-    "solve",
     "solve_updates",
+    "trace_outputs",
     "update",
+    "update_one",
     "window_plan",
 ]
 
@@ -95,6 +104,7 @@ class WindowPlan(NamedTuple):
     window: int  #: W, lag rows per window
     cluster: int  #: C, lag rows between updates
     min_rows: int  #: windows with fewer rows are "not enough data": no solve runs
+    block: int  #: B, rows of a block summarised once (a multiple of C; see block_rows)
 
 
 class Solved(NamedTuple):
@@ -241,38 +251,48 @@ def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, i
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def merge(
     blocks: tuple[np.ndarray, np.ndarray, int, int, int],
-    tail: tuple[int, np.ndarray, np.ndarray],
+    pieces: tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray],
     dev: np.ndarray,
     out: tuple[np.ndarray, np.ndarray],
 ) -> float:
-    """Merge full blocks and a tail piece into one window (Chan, Golub and LeVeque).
+    """Merge full blocks, a tail and a head piece into one window (Chan, Golub and LeVeque).
 
     ``blocks = (b_mean (n, p), b_scat (n, p, p), lo, hi, size)``: blocks ``lo .. hi - 1``
-    of ``size`` rows; ``tail = (t_size, t_mean, t_scat)`` (skipped when ``t_size`` is 0);
-    ``dev`` work space (pieces, p); ``out = (mean, scat)``. Returns the row count.
+    of ``size`` rows; ``pieces = (t_size, t_mean, t_scat, h_size, h_mean, h_scat)``: the
+    tail (the rows before the first full block) and the head (the rows after the last);
+    a piece of size 0 is skipped. ``dev`` work space (pieces, p); ``out = (mean, scat)``.
+    Returns the row count.
     """
     b_mean, b_scat, lo, hi, size = blocks
-    t_size, t_mean, t_scat = tail
+    t_size, t_mean, t_scat, h_size, h_mean, h_scat = pieces
     mean, scat = out
     p = mean.shape[0]
-    total = t_size + size * (hi - lo)
+    total = t_size + size * (hi - lo) + h_size
     for a in range(p):
         acc = t_size * t_mean[a] if t_size > 0 else 0.0
         for k in range(lo, hi):
             acc += size * b_mean[k, a]
+        if h_size > 0:
+            acc += h_size * h_mean[a]
         mean[a] = acc / total
     root = math.sqrt(size)
     t_root = math.sqrt(t_size)
+    n_dev = hi - lo + 1
     for a in range(p):
         dev[0, a] = t_root * (t_mean[a] - mean[a]) if t_size > 0 else 0.0
         for k in range(lo, hi):
             dev[k - lo + 1, a] = root * (b_mean[k, a] - mean[a])
-    n_dev = hi - lo + 1
+        if h_size > 0:
+            dev[n_dev, a] = math.sqrt(h_size) * (h_mean[a] - mean[a])
+    if h_size > 0:
+        n_dev += 1
     for a in range(p):
         for b in range(a + 1):
             acc = t_scat[a, b] if t_size > 0 else 0.0
             for k in range(lo, hi):
                 acc += b_scat[k, a, b]
+            if h_size > 0:
+                acc += h_scat[a, b]
             for k in range(n_dev):
                 acc += dev[k, a] * dev[k, b]
             scat[a, b] = acc
@@ -328,6 +348,78 @@ def solve_one(
     )
 
 
+class BlockCache(NamedTuple):
+    """Statistics of the newest blocks, kept between kernel calls (see :func:`new_cache`).
+
+    A block's statistics are a function of its rows alone, so a block summarised by an
+    earlier call is reused bit for bit: ``step`` then summarises one new block per update
+    instead of the whole window. Blocks ``span[0] .. span[1] - 1`` are held, block ``k``
+    at ring position ``k % M`` (``M`` = the second axis; 0: no cache).
+    """
+
+    mean: np.ndarray  #: (E, M, p)
+    scat: np.ndarray  #: (E, M, p, p)
+    step: np.ndarray  #: (E, M)
+    span: np.ndarray  #: (2,) int64
+
+
+def new_cache(shape: tuple[int, int], ring: int) -> BlockCache:
+    """An empty :class:`BlockCache` of ``ring`` blocks per equation (0: caching off).
+
+    ``shape = (E, p)``: equations and parameters per equation.
+    """
+    n_eq, p = shape
+    return BlockCache(
+        np.zeros((n_eq, ring, p)),
+        np.zeros((n_eq, ring, p, p)),
+        np.zeros((n_eq, ring)),
+        np.zeros(2, np.int64),
+    )
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def gather_blocks(
+    samples: np.ndarray,
+    where: tuple[np.ndarray, np.ndarray, int, int, int, int],
+    cache: tuple[np.ndarray, np.ndarray, np.ndarray, int, int],
+    z: np.ndarray,
+    blocks: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """Statistics of blocks ``b_lo .. b_lo + n - 1`` of one equation, from the cache or rows.
+
+    ``where = (chan, lag, first, b_lo, n, size)``; ``cache = (mean (M, p), scat (M, p, p),
+    step (M,), lo, hi)``: one equation's ring and the blocks it holds; ``blocks = (b_mean,
+    b_scat, b_step)``. The newest ``min(n, M)`` blocks are written back into the ring.
+    """
+    chan, lag, first, b_lo, n, size = where
+    c_mean, c_scat, c_step, c_lo, c_hi = cache
+    b_mean, b_scat, b_step = blocks
+    ring = c_mean.shape[0]
+    p = c_mean.shape[1]
+    for b in range(n):
+        k = b_lo + b
+        if c_lo <= k < c_hi:
+            pos = k % ring
+            for a in range(p):
+                b_mean[b, a] = c_mean[pos, a]
+                for c in range(p):
+                    b_scat[b, a, c] = c_scat[pos, a, c]
+            b_step[b] = c_step[pos]
+        else:
+            lo = k * size
+            piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
+            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + size))
+    if ring == 0:
+        return
+    for b in range(max(0, n - ring), n):
+        pos = (b_lo + b) % ring
+        for a in range(p):
+            c_mean[pos, a] = b_mean[b, a]
+            for c in range(p):
+                c_scat[pos, a, c] = b_scat[b, a, c]
+        c_step[pos] = b_step[b]
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_windows(
     samples: np.ndarray,
@@ -336,6 +428,7 @@ def solve_windows(
     plan: WindowPlan,
     s: SolveSettings,
     out: Solved,
+    cache: BlockCache,
 ) -> None:
     """Solve windows ``j0 .. j0 + count - 1`` (``windows = (j0, count)``) of every equation.
 
@@ -343,31 +436,38 @@ def solve_windows(
     ``samples[r - first_row]``. Windows with fewer than ``plan.min_rows`` rows are not
     solved (their outputs are zero and flagged degenerate). A channel's quantization step
     in a window (for :func:`clpc.core.rules.is_excited`) is its smallest nonzero change
-    between consecutive samples of the window.
+    between consecutive samples of the window. ``cache`` (:class:`BlockCache`) supplies the
+    blocks an earlier call summarised and keeps the newest (updated in place).
     """
     j0, count = windows
     n_eq, p = plan.chan.shape
-    window, cluster = plan.window, plan.cluster
+    window, cluster, size = plan.window, plan.cluster, plan.block
     first = -first_row
-    b_lo = max(0, cluster * j0 - window) // cluster  # the block holding the first start
-    n_blocks = j0 + count - 1 - b_lo  # block j - 1 is the newest of window j
+    b_lo = -(-max(0, cluster * j0 - window) // size)  # the first full block of any window
+    n_blocks = max(0, cluster * (j0 + count - 1) // size - b_lo)
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
     b_step = np.empty(n_blocks)
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
-    dev = np.empty((window // cluster + 2, p))
+    h_mean = np.empty(p)
+    h_scat = np.empty((p, p))
+    dev = np.empty((window // size + 3, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
     z = np.empty(p)
     work = new_work(p)
+    c_lo, c_hi = cache.span[0], cache.span[1]
     for eq in range(n_eq):
         chan = plan.chan[eq]
         lag = plan.lag[eq]
-        for b in range(n_blocks):
-            lo = (b_lo + b) * cluster
-            piece_stats(samples, chan, lag, first, (lo, lo + cluster), z, (b_mean[b], b_scat[b]))
-            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + cluster))
+        gather_blocks(
+            samples,
+            (chan, lag, first, b_lo, n_blocks, size),
+            (cache.mean[eq], cache.scat[eq], cache.step[eq], c_lo, c_hi),
+            z,
+            (b_mean, b_scat, b_step),
+        )
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -386,19 +486,25 @@ def solve_windows(
                 out.degenerate[w, eq] = True
                 out.excited[w, eq] = False
                 continue
-            full_lo = -(-start // cluster)
-            t_size = full_lo * cluster - start  # the tail of the block holding start
+            # rows [start, e) = tail [start, full_lo B) + blocks + head [full_hi B, e)
+            full_lo = -(-start // size)
+            full_hi = max(e // size, full_lo)
+            t_end = min(full_lo * size, e)
+            h_start = min(max(full_hi * size, t_end), e)
+            t_size = t_end - start
+            h_size = e - h_start
             if t_size > 0:
-                piece_stats(
-                    samples, chan, lag, first, (start, full_lo * cluster), z, (t_mean, t_scat)
-                )
+                piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
+            if h_size > 0:
+                piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
             # the output's quantization step in the window (column 0 is y(n))
-            step = piece_step(samples, chan[0], first, (start, full_lo * cluster))
-            for b in range(full_lo - b_lo, j - b_lo):
+            step = piece_step(samples, chan[0], first, (start, t_end))
+            step = min(step, piece_step(samples, chan[0], first, (h_start, e)))
+            for b in range(full_lo - b_lo, full_hi - b_lo):
                 step = min(step, b_step[b])
             n_w = merge(
-                (b_mean, b_scat, full_lo - b_lo, j - b_lo, cluster),
-                (t_size, t_mean, t_scat),
+                (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
+                (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
                 dev,
                 (mean, scat),
             )
@@ -413,6 +519,9 @@ def solve_windows(
             out.n_input_relations[w, eq] = res[5]
             out.degenerate[w, eq] = res[6]
             out.excited[w, eq] = is_excited(scat, n_w, step, s.n_out_cols)
+    if cache.mean.shape[1] > 0 and n_blocks > 0:
+        cache.span[0] = b_lo + max(0, n_blocks - cache.mean.shape[1])
+        cache.span[1] = b_lo + n_blocks
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -484,20 +593,22 @@ def update_windows(
     settings: tuple[Any, ...],
     state: tuple[Any, ...],
     out: tuple[Any, ...],
+    cache: tuple[np.ndarray, ...],
 ) -> None:
     """:func:`solve_windows` then :func:`fsm_output` in one call (one dispatch per update).
 
     The containers arrive as plain tuples - ``settings = (plan, solve settings, FSM
-    settings)``, ``state``, ``out = (solved, output)`` - in the fields' order of
+    settings)``, ``state``, ``out = (solved, output)``, ``cache`` - in the fields' order of
     :class:`WindowPlan`, :class:`SolveSettings`, :class:`FsmSettings`, :class:`FsmState`,
-    :class:`Solved` and :class:`FsmOutput`: numba types plain tuples of arrays several
-    times faster than named tuples at the call, which is most of the cost of one update.
+    :class:`Solved`, :class:`FsmOutput` and :class:`BlockCache`: numba types plain tuples
+    of arrays several times faster than named tuples at the call, which is most of the cost
+    of one update.
     """
     plan = WindowPlan(*settings[0])
     s = SolveSettings(*settings[1])
     fs = FsmSettings(*settings[2])
     solved = Solved(*out[0])
-    solve_windows(samples, first_row, windows, plan, s, solved)
+    solve_windows(samples, first_row, windows, plan, s, solved, BlockCache(*cache))
     fsm_output(solved, fs, FsmState(*state), FsmOutput(*out[1]))
 
 
@@ -599,9 +710,32 @@ def window_plan(
     transform = np.eye(p) if noise is None else fixed_transform(noise, p)
     window, cluster, min_rows = sizes
     plan = WindowPlan(
-        chan, lag, col_channel, np.ascontiguousarray(transform), window, cluster, min_rows
+        chan,
+        lag,
+        col_channel,
+        np.ascontiguousarray(transform),
+        window,
+        cluster,
+        min_rows,
+        block_rows(window, cluster),
     )
     return plan, n_blocks + 1
+
+
+def cache_blocks(plan: WindowPlan) -> int:
+    """Blocks a :class:`BlockCache` holds: those of one window, and one more."""
+    return plan.window // plan.block + 2
+
+
+def block_rows(window: int, cluster: int) -> int:
+    """Rows ``B`` of a block: ``C``, or a multiple of it near ``sqrt(W)`` when ``C`` is small.
+
+    A window costs its tail and head pieces (up to ``B`` rows each, summarised per window)
+    plus a merge over its ``W / B`` full blocks; ``B ~ sqrt(W)`` balances the two. With
+    ``C >= sqrt(W) / 1.5`` (the paper's ``C = 12``, ``W = 201``) ``B = C`` and windows have
+    no head piece.
+    """
+    return cluster * max(1, round(math.sqrt(window) / cluster))
 
 
 def settings_for(
@@ -620,9 +754,16 @@ def settings_for(
     return solve_settings(rule, name == "robust", mode, na + 1, n_channels)
 
 
+#: a kernel call's outputs as plain tuples, in the fields' order of Solved and FsmOutput
+Plain = tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]
+
+
 def update(
-    samples: tuple[np.ndarray, int], windows: tuple[int, int], setup: KernelSetup, state: FsmState
-) -> tuple[Solved, FsmOutput]:
+    samples: tuple[np.ndarray, int],
+    windows: tuple[int, int],
+    setup: KernelSetup,
+    state: tuple[FsmState, BlockCache],
+) -> Plain:
     """Solve ``windows`` and run the FSM output over them in one kernel call.
 
     Parameters
@@ -634,67 +775,56 @@ def update(
     setup : KernelSetup
         The record's :class:`KernelSetup` (its ``plain`` settings go
         to :func:`update_windows`).
-    state : FsmState
-        The carried :class:`FsmState` (updated in place).
+    state : (FsmState, BlockCache)
+        The carried :class:`FsmState` and the record's :class:`BlockCache` (both updated
+        in place).
 
     Returns
     -------
-    solved : Solved
-    output : FsmOutput
+    solved, output : tuple of ndarray
+        The fields of :class:`Solved` and of :class:`FsmOutput`, in order (plain tuples:
+        the hot path of ``step`` builds no named tuples).
     """
-    solved = _solved(windows[1], setup.plan)
-    out = _fsm_output(solved, setup.fsm, setup.n_inputs)
+    solved, out = outputs(windows[1], setup)
+    fsm, cache = state
     update_windows(
-        samples[0], samples[1], windows, setup.plain, tuple(state), (tuple(solved), tuple(out))
+        samples[0], samples[1], windows, setup.plain, tuple(fsm), (solved, out), tuple(cache)
     )
     return solved, out
 
 
-def solve(
-    samples: np.ndarray,
-    first_row: int,
-    windows: tuple[int, int],
-    plan: WindowPlan,
-    settings: SolveSettings,
-) -> Solved:
-    """Solve ``windows = (j0, count)`` (see :func:`solve_windows`)."""
-    out = _solved(windows[1], plan)
-    solve_windows(samples, first_row, windows, plan, settings, out)
-    return out
+def update_one(
+    setup: KernelSetup,
+    samples: tuple[np.ndarray, int],
+    j: int,
+    state: tuple[FsmState, BlockCache],
+) -> dict[str, np.ndarray]:
+    """Update ``j`` alone (:func:`update` with one window): the arrays of its trace row.
+
+    The streaming path (``step``, small ``push`` chunks): one kernel call, no batching.
+    Returns the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION` plus
+    ``not_enough`` and ``n_rows``, each with one row.
+    """
+    return _arrays(*update(samples, (j, 1), setup, state))
 
 
-def output(solved: Solved, fs: FsmSettings, state: FsmState, n_inputs: int) -> FsmOutput:
-    """The FSM output of ``solved`` (``state`` is updated in place)."""
-    out = _fsm_output(solved, fs, n_inputs)
-    fsm_output(solved, fs, state, out)
-    return out
+def outputs(count: int, setup: KernelSetup) -> Plain:
+    """Uninitialised output arrays of ``count`` updates, as plain tuples (see :data:`Plain`).
 
-
-def _solved(count: int, plan: WindowPlan) -> Solved:
-    e, p = plan.chan.shape
-    f = np.empty((2, count, e, p))  # same-shape fields share one allocation (hot path)
-    g = np.empty((4, count, e))
+    Fields of the same shape and type share one allocation (a call of ``step`` allocates
+    them all for one update: their number is most of its cost).
+    """
+    e, p = setup.plan.chan.shape
+    fs = setup.fsm
+    f = np.empty((3, count, e, p))
+    g = np.empty((10, count, e))
     i = np.empty((2, count, e), np.int64)
-    b = np.empty((2, count, e), np.bool_)
-    fields = (*f, *g, *i, *b, np.empty(count, np.int64))
-    return Solved(*fields)
-
-
-def _fsm_output(solved: Solved, fs: FsmSettings, n_inputs: int) -> FsmOutput:
-    count, e, p = solved.theta.shape
-    b = np.empty((5, count, e), np.bool_)
-    g = np.empty((5, count, e))
-    fields = (
-        np.empty((count, e, p)),
-        np.empty((count, e)),
-        *b[:4],
-        np.empty(count, np.bool_),
-        np.empty((count, e, fs.na + 1)),
-        np.empty((count, e, n_inputs, fs.nk + fs.nb + 1)),
-        b[4],
-        *g,
-    )
-    return FsmOutput(*fields)
+    b = np.empty((7, count, e), np.bool_)
+    solved = (f[0], f[1], g[0], g[1], g[2], g[3], i[0], i[1], b[0], b[1])
+    den = np.empty((count, e, fs.na + 1))
+    num = np.empty((count, e, setup.n_inputs, fs.nk + fs.nb + 1))
+    out = (f[2], g[4], b[2], b[3], b[4], b[5], np.empty(count, np.bool_), den, num, b[6])
+    return (*solved, np.empty(count, np.int64)), (*out, g[5], g[6], g[7], g[8], g[9])
 
 
 def batches(j_first: int, j_last: int, n_jobs: int) -> list[tuple[int, int]]:
@@ -711,9 +841,10 @@ def solve_updates(
     setup: KernelSetup,
     samples: tuple[np.ndarray, int],
     updates: tuple[int, int],
-    state: FsmState,
+    state: tuple[FsmState, BlockCache],
+    dest: Plain,
     threads: tuple[int, Callable[..., Any]] = (1, map),
-) -> list[tuple[int, int, dict[str, np.ndarray]]]:
+) -> None:
     """Solve updates ``updates = (j_first, j_last)`` and run the FSM output over them.
 
     Parameters
@@ -723,60 +854,82 @@ def solve_updates(
         Buffered samples (n, channels) and the absolute lag row of ``buffer[0]`` minus
         ``max_lag`` (see :func:`solve_windows`).
     updates : (j_first, j_last)
-    state : FsmState
-        The carried FSM state, updated in place.
+    state : (FsmState, BlockCache)
+        The carried FSM state and the record's block cache, updated in place (the threads
+        use no cache: their batches run at once).
+    dest : Plain
+        Where the outputs go, one row per update (e.g. :func:`outputs`, or
+        :func:`trace_outputs` to write straight into a trace); each batch writes its rows.
     threads : (n_jobs, map)
         Thread count and ``map`` or a thread pool's ``map`` (batches are independent).
-
-    Returns
-    -------
-    list of (j0, count, arrays)
-        Per batch, the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION`
-        plus ``not_enough`` and ``n_rows``.
     """
     buf, first_row = samples
     n_jobs, mapper = threads
-    parts = batches(updates[0], updates[1], n_jobs)
+    fsm, cache = state
+    j_first = updates[0]
+    parts = batches(j_first, updates[1], n_jobs)
+    views = [_rows(dest, j0 - j_first, j0 - j_first + c) for j0, c in parts]
     if n_jobs == 1 or len(parts) == 1:  # solve and output in one kernel call per batch
-        run = update
-        return [(j0, c, _arrays(*run(samples, (j0, c), setup, state))) for j0, c in parts]
+        plain_state, plain_cache = tuple(fsm), tuple(cache)
+        for batch, (solved, out) in zip(parts, views, strict=True):
+            update_windows(
+                buf, first_row, batch, setup.plain, plain_state, (solved, out), plain_cache
+            )
+        return
+    off = new_cache(setup.plan.chan.shape, 0)
 
-    def solve_batch(batch: tuple[int, int]) -> Solved:
-        return solve(buf, first_row, batch, setup.plan, setup.settings)
+    def solve_batch(k: int) -> int:
+        solved = Solved(*views[k][0])
+        solve_windows(buf, first_row, parts[k], setup.plan, setup.settings, solved, off)
+        return k
 
-    solved = list(mapper(solve_batch, parts))  # windows are independent: threads
-    return [  # the FSM output runs in time order
-        (j0, count, _arrays(sol, output(sol, setup.fsm, state, setup.n_inputs)))
-        for (j0, count), sol in zip(parts, solved, strict=True)
-    ]
+    # windows are independent: threads; the FSM output runs in time order, each batch's as
+    # soon as it is solved (while the threads solve the next ones)
+    for k in mapper(solve_batch, range(len(parts))):
+        fsm_output(Solved(*views[k][0]), setup.fsm, fsm, FsmOutput(*views[k][1]))
 
 
-def _arrays(sol: Solved, fsm: FsmOutput) -> dict[str, np.ndarray]:
-    """The per-update arrays of a trace part, from the kernel's two outputs."""
-    return {
-        "theta": fsm.theta,
-        "c": fsm.c,
-        "accepted": fsm.accepted,
-        "has_model": fsm.has_model,
-        "determined": fsm.determined,
-        "trusted": fsm.trusted,
-        "not_enough": fsm.not_enough,
-        "den": fsm.den,
-        "num": fsm.num,
-        "stable": fsm.stable,
-        "lambda_min": fsm.lambda_min,
-        "lambda_max": fsm.lambda_max,
-        "D": fsm.D,
-        "eig_ratio": fsm.eig_ratio,
-        "J": fsm.J,
-        "theta_estimate": sol.theta,
-        "eigenvalues": sol.eigenvalues,
-        "separation": sol.separation,
-        "a0_weight": sol.a0_weight,
-        "noise_variance": sol.noise_variance,
-        "n_null": sol.n_null,
-        "n_input_relations": sol.n_input_relations,
-        "degenerate": sol.degenerate,
-        "excited": sol.excited,
-        "n_rows": sol.n_rows,
-    }
+def trace_outputs(arrays: dict[str, np.ndarray], rows: np.ndarray, not_enough: np.ndarray) -> Plain:
+    """The kernel's outputs as the arrays of a trace (see :data:`Plain`): no copies.
+
+    ``arrays`` holds the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION`,
+    ``rows`` and ``not_enough`` the rows and flags (all with the same number of rows);
+    the solved ``c`` (not in a trace) gets a scratch array.
+    """
+    scratch = np.empty(arrays["c"].shape)
+    solved = tuple(
+        scratch if key is None else rows if key == "n_rows" else arrays[key] for key in _SOLVED_KEYS
+    )
+    out = tuple(not_enough if key == "not_enough" else arrays[key] for key in _FSM_KEYS)
+    return solved, out
+
+
+def _rows(plain: Plain, lo: int, hi: int) -> Plain:
+    """Rows ``lo .. hi - 1`` of every output (views, C-contiguous)."""
+    return tuple(a[lo:hi] for a in plain[0]), tuple(a[lo:hi] for a in plain[1])
+
+
+#: trace keys of the fields of Solved (None: not in the trace) and of FsmOutput
+_SOLVED_KEYS = (
+    "theta_estimate",
+    "eigenvalues",
+    None,
+    "noise_variance",
+    "separation",
+    "a0_weight",
+    "n_null",
+    "n_input_relations",
+    "degenerate",
+    "excited",
+    "n_rows",
+)
+_FSM_KEYS = tuple(FsmOutput._fields)
+
+
+def _arrays(solved: tuple[np.ndarray, ...], out: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """The per-update arrays of a trace part, from the kernel's two outputs (plain tuples)."""
+    arrays = dict(zip(_FSM_KEYS, out, strict=True))
+    for key, value in zip(_SOLVED_KEYS, solved, strict=True):
+        if key is not None:
+            arrays[key] = value
+    return arrays

@@ -57,9 +57,9 @@ class Settings:
         def put(name: str, value: Any) -> None:
             object.__setattr__(self, name, value)
 
-        def count(name: str, low: int, high: int | None = None) -> None:
+        def count(name: str, low: int, high: int | None = None, required: bool = False) -> None:
             value = getattr(self, name)
-            if value is not None:
+            if value is not None or required:  # check_int refuses None with the name
                 put(name, check_int(value, name, low, high))
 
         def seconds(name: str) -> None:
@@ -68,8 +68,8 @@ class Settings:
                 put(name, check_positive(value, name, "s"))
 
         count("order", 1)
-        count("window_size", 2)
-        count("cluster_size", 1)
+        count("window_size", 2, required=True)
+        count("cluster_size", 1, required=True)
         seconds("dt")
         seconds("decimate_to")
         put("guard", check_bool(self.guard, "guard"))
@@ -86,8 +86,8 @@ class Settings:
         put("rule", self.rule or RobustRule())
         count("trust_rows", 1, _TOP)
         count("min_rows", 2, _TOP)
-        count("n_jobs", 1)
-        count("chunk_samples", 1024)
+        count("n_jobs", 1, required=True)
+        count("chunk_samples", 1024, required=True)
         self.check_window(self.structure.n_params())  # one input: the fewest parameters
 
     def check_window(self, p: int) -> None:

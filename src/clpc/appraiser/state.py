@@ -67,6 +67,7 @@ class AppraiserState:
     setup: kernel.KernelSetup | None = None
     labels: TraceLabels | None = None
     empty: Trace | None = None
+    blocks: kernel.BlockCache | None = None  #: statistics of the newest blocks (derived)
 
     def __post_init__(self) -> None:
         self.max_lag = self.settings.structure.max_lag
@@ -198,39 +199,91 @@ class AppraiserState:
         return self.consume(block, mapper)
 
     def consume(self, new: np.ndarray, mapper: Callable[..., Any] = map) -> Trace:
-        """Append decimated samples and compute the updates they complete.
+        """Append decimated samples and compute the updates they complete (a new trace).
 
         ``mapper`` is ``map`` or a thread pool's (``n_jobs > 1``: batches on threads).
         """
         if new.shape[0] == 0:
             return self.empty_trace()
+        count = self._append(new)
+        if count == 1:  # one update (step, small pushes): one kernel call, no batching
+            trace = self._one_update()
+        elif count > 1:
+            trace = Trace.allocate(self.empty_trace(), count)
+            self._solve_into(trace, mapper)
+        else:
+            trace = self.empty_trace()
+        self._forget()
+        return trace
+
+    def consume_into(
+        self, new: np.ndarray, mapper: Callable[..., Any], out: Trace, row: int
+    ) -> int:
+        """:meth:`consume`, writing the updates into rows ``row ..`` of ``out``; the next row.
+
+        ``out`` comes from :meth:`Trace.allocate` with room for them: the kernel writes into
+        its arrays directly (no copy of the updates).
+        """
+        if new.shape[0] == 0:
+            return row
+        count = self._append(new)
+        if count > 0:
+            self._solve_into(out.view(row, row + count), mapper)
+        self._forget()
+        return row + count
+
+    def _append(self, new: np.ndarray) -> int:
+        """Append decimated samples to the buffer; returns the updates they complete."""
         buf = self.buffer
-        assert buf is not None and self.last_theta is not None
-        assert self.last_c is not None and self.has_model is not None
+        assert buf is not None
         buf.append(new)
         self.n_seen += new.shape[0]
-        c, w, max_lag = self.cluster, self.settings.window_size, self.max_lag
-        j_last = max(self.n_seen - max_lag, 0) // c
-        trace = self.empty_trace()
-        if j_last > self.j_done:
-            state = kernel.FsmState(self.last_theta, self.last_c, self.has_model)
-            parts = kernel.solve_updates(
-                self.kernel_setup(),
-                (buf.data, buf.start - max_lag),
-                (self.j_done + 1, j_last),
-                state,
-                (self.settings.n_jobs, mapper),
-            )
-            labels = self.trace_labels()
-            traces = []
-            for j0, count, arrays in parts:
-                index = max_lag + c * np.arange(j0, j0 + count) - 1
-                traces.append(labels.trace(index, arrays.pop("n_rows"), arrays))
-            trace = traces[0] if len(traces) == 1 else Trace.concat(traces)
-            self.j_done = j_last
-        # keep only what the next window needs: rows from max(0, C (j+1) - W - C)
-        buf.drop_before(max(0, c * (self.j_done + 1) - w - c))
+        return max(self.n_seen - self.max_lag, 0) // self.cluster - self.j_done
+
+    def _fsm_state(self) -> tuple[kernel.FsmState, kernel.BlockCache]:
+        """The carried FSM state and the block cache (made on first use; never saved)."""
+        assert self.last_theta is not None and self.last_c is not None
+        assert self.has_model is not None
+        if self.blocks is None:
+            plan = self.kernel_setup().plan
+            self.blocks = kernel.new_cache(plan.chan.shape, kernel.cache_blocks(plan))
+        return kernel.FsmState(self.last_theta, self.last_c, self.has_model), self.blocks
+
+    def _one_update(self) -> Trace:
+        """The next update alone, as a new trace (the lean path of ``step``)."""
+        buf = self.buffer
+        assert buf is not None
+        j = self.j_done + 1
+        samples = (buf.data, buf.start - self.max_lag)
+        setup = self.setup or self.kernel_setup()
+        arrays = kernel.update_one(setup, samples, j, self._fsm_state())
+        index = np.array([self.max_lag + self.cluster * j - 1])
+        trace = (self.labels or self.trace_labels()).trace(index, arrays.pop("n_rows"), arrays)
+        self.j_done = j
         return trace
+
+    def _solve_into(self, part: Trace, mapper: Callable[..., Any]) -> None:
+        """The next ``len(part)`` updates, written into ``part``'s arrays."""
+        buf = self.buffer
+        assert buf is not None
+        j0, j_last = self.j_done + 1, self.j_done + len(part)
+        kernel.solve_updates(
+            self.kernel_setup(),
+            (buf.data, buf.start - self.max_lag),
+            (j0, j_last),
+            self._fsm_state(),
+            kernel.trace_outputs(part.arrays, part.rows, part.not_enough_data),
+            (self.settings.n_jobs, mapper),
+        )
+        part.index[:] = self.max_lag + self.cluster * np.arange(j0, j_last + 1) - 1
+        part.time[:] = part.index * part.sample_time
+        self.j_done = j_last
+
+    def _forget(self) -> None:
+        """Keep only what the next window needs: rows from ``max(0, C (j+1) - W - C)``."""
+        assert self.buffer is not None
+        c = self.cluster
+        self.buffer.drop_before(max(0, c * (self.j_done + 1) - self.settings.window_size - c))
 
     def empty_trace(self) -> Trace:
         """A trace without updates, shaped for the record's channels (cached once known)."""
