@@ -168,3 +168,19 @@ def test_summary_rows_are_small(fleet):
     assert max(sizes) < 8000
     row = json.loads((root / "out" / names[0] / ROW_NAME).read_text())
     assert len(row["drift_time"]) <= 100
+
+
+def test_no_sample_is_read_by_the_client(fleet, client, monkeypatch):
+    import clpc.io
+    import clpc.workflows.track
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the client read a record")
+
+    for module in (clpc.io, clpc.workflows.track):  # this process only; workers are others
+        monkeypatch.setattr(module, "iter_table_chunks", refuse)
+    monkeypatch.setattr(clpc.io, "read_table", refuse)
+    root, names, result, _ = fleet
+    got = track_many(root / "ds" / names[0] / "part.parquet", client=client, **SETTINGS)
+    assert got.table["error"].isna().all()
+    assert np.array_equal(np.stack(got.table["den"][0]), np.stack(result.table["den"][0]))

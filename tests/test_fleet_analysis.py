@@ -219,3 +219,18 @@ def test_track_many_refuses_bad_sources_before_starting_a_cluster(tmp_path):
         ],
     )
     assert res.exit_code == 2 and "cannot resample" in res.output, res.output
+
+
+def test_records_without_a_common_band_are_listed_not_ranked():
+    from clpc.workflows.fleet_table import rank_rows
+
+    model = _model()
+    row = {"den": model.den.tolist(), "num": model.num.tolist(), "dt": model.dt, "error": None}
+    bands = ([520.0, 600.0], [540.0, 700.0])  # median 530-650 Hz, above the Nyquist 500 Hz
+    rows = [dict(row, name=n, band_hz=b) for n, b in zip("ab", bands, strict=True)]
+    ranked, band, ref, method = rank_rows(rows)
+    assert band is None and ref is not None and all(r["rank"] is None for r in ranked)
+    assert method.startswith("The records are not ranked: the band 530 Hz is above")
+    ranked, band, _, method = rank_rows([dict(r, band_hz=None) for r in rows])
+    assert band is None and "no band to compare over" in method
+    assert rank_rows([{"name": "x", "error": "DataError: bad"}])[3].startswith("No record has")

@@ -126,8 +126,13 @@ def rank_rows(rows: Sequence[dict[str, Any]]) -> tuple[list[dict[str, Any]], Any
     if not bands:
         return out, None, None, "No record's input varies: there is no band to compare over."
     reference = median_model([m for _, m in have])
-    lo, hi = fleet_band(bands)
-    hi = min(hi, *(0.5 / m.dt for _, m in have))
+    try:
+        lo, hi = fleet_band(bands)
+        hi = min(hi, *(0.5 / m.dt for _, m in have))
+        if not lo < hi:
+            raise ValueError(f"the band {lo:g} Hz is above the lowest Nyquist frequency {hi:g} Hz")
+    except ValueError as exc:
+        return out, None, reference, f"The records are not ranked: {exc}."
     grid = band_grid((lo, hi))
     d = [response_distance(m, reference, grid) for _, m in have]
     z, flag = outlier_scores(d)
