@@ -190,3 +190,31 @@ def test_bad_samples_and_short_records_behave_as_in_one_process(client):
     with pytest.raises(DataError, match="differ in scale"):
         small, big = da.from_array(u * 1e-9, chunks=1_000), da.from_array(y * 1e9, chunks=1_000)
         run_long(CLPC(), small, big, client=client, piece_samples=500)
+
+
+def test_the_workers_write_the_trace_as_a_dataset_and_the_summary_reads_all_of_it(client, tmp_path):
+    import pandas as pd
+
+    from clpc.appraiser.tracefile import trace_columns
+    from clpc.distributed import track_long
+    from clpc.report import trace_summary
+
+    u, y = _record(20_003)
+    np.save(tmp_path / "rec.npy", np.column_stack([u, y]))
+    settings = {"window_size": 90, "cluster_size": 10}
+    ref = CLPC(**settings).run(u, y)
+    source = open_source(tmp_path / "rec.npy", (0,), (1,))
+    for _ in range(2):  # a second run replaces the first run's dataset
+        result = track_long(CLPC(**settings), source, tmp_path / "out", client=client,
+                            piece_samples=1_500)  # fmt: skip
+    assert result.parts == len(list((tmp_path / "out" / "trace").glob("part-*.parquet"))) > 5
+    assert not list((tmp_path / "out").glob(".trace*"))  # no staging folder left
+    table = pd.read_parquet(tmp_path / "out" / "trace")
+    table = table.sort_values("index")
+    ref = dataclasses.replace(ref, input_names=("col0",), output_names=("col1",))
+    names, want = trace_columns(ref)
+    assert list(table.columns) == names
+    assert np.array_equal(table.to_numpy(dtype=np.float64), want)
+    expected = trace_summary(ref)
+    assert result.summary == expected
+    assert result.model is not None and result.model_source == expected["model_source"]

@@ -9,9 +9,11 @@ from __future__ import annotations
 
 from clpc.distributed.cluster import dask_client, default_workers, require_distributed
 from clpc.distributed.long_record import run_long
+from clpc.distributed.long_track import LongTrack, track_long
 from clpc.distributed.sources import NpySource, ParquetSource, open_source
 
 __all__ = [
+    "LongTrack",
     "NpySource",
     "ParquetSource",
     "dask_client",
@@ -19,4 +21,5 @@ __all__ = [
     "open_source",
     "require_distributed",
     "run_long",
+    "track_long",
 ]

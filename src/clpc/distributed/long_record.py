@@ -38,7 +38,16 @@ from clpc.distributed.piece_tasks import (
 from clpc.distributed.pieces import Layout, Piece
 from clpc.distributed.sources import NpySource, ParquetSource
 
-__all__ = ["AHEAD", "PIECE_SAMPLES", "is_dask_array", "plan_record", "run_long"]
+__all__ = [
+    "AHEAD",
+    "PIECE_SAMPLES",
+    "check_peaks",
+    "gather",
+    "is_dask_array",
+    "plan_record",
+    "run_long",
+    "run_pieces",
+]
 
 #: decimated samples per piece by default (about 1 s of one core's solving)
 PIECE_SAMPLES = 1 << 20
@@ -103,10 +112,34 @@ def _reader(record: Any) -> Callable[[Any, Piece], Any]:
     return read
 
 
-def _run_pieces(
-    client: Any, plan: RecordPlan, record: Any, piece_samples: int, out: str | None
-) -> tuple[list[Any], np.ndarray]:
-    """Run every piece; returns what :func:`finish_piece` returned, in time order, and peaks."""
+def run_pieces(
+    client: Any,
+    plan: RecordPlan,
+    record: Any,
+    piece_samples: int = PIECE_SAMPLES,
+    out: tuple[str, tuple[str, ...]] | None = None,
+) -> tuple[list[Trace], np.ndarray]:
+    """Run every piece of a record on ``client``.
+
+    Parameters
+    ----------
+    client : distributed.Client
+    plan : RecordPlan
+    record : source or (dask.array.Array, dask.array.Array)
+        A file source, or inputs and outputs as 2-D dask arrays.
+    piece_samples : int
+        Decimated samples per piece.
+    out : (str, tuple of str), optional
+        ``(folder, keys)``: the workers write each piece's rows to
+        ``folder/part-NNNNNN.parquet`` and return only the arrays ``keys``.
+
+    Returns
+    -------
+    parts : list of Trace
+        The pieces' traces in time order (what :func:`.piece_tasks.finish_piece` returned).
+    peaks : ndarray, shape (channels,)
+        The largest magnitude of every raw channel of the record.
+    """
     pieces = plan.layout.pieces(plan.n_raw, piece_samples)
     if pieces:  # the last piece reads to the end (the whole record is checked)
         last = pieces[-1]
@@ -125,8 +158,9 @@ def _run_pieces(
             solved = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
             outputs = client.submit(fsm_piece, solved, plan, state, pure=False)
             state = client.submit(end_state, outputs, pure=False)
-            path = None if out is None else f"{out}/part-{piece.number:06d}.parquet"
-            done = client.submit(finish_piece, solved, outputs, plan, path, pure=False)
+            path = None if out is None else f"{out[0]}/part-{piece.number:06d}.parquet"
+            keep = None if out is None else out[1]
+            done = client.submit(finish_piece, solved, outputs, plan, path, keep, pure=False)
             peak = client.submit(_peaks, solved, pure=False)
             inflight.append((done, peak))
         done, peak = inflight.popleft()
@@ -139,7 +173,7 @@ def _peaks(solved: SolvedPiece) -> np.ndarray:
     return solved.peaks
 
 
-def _gather(parts: list[Trace]) -> Trace:
+def gather(parts: list[Trace]) -> Trace:
     """The record's trace from its pieces' traces (window levels joined)."""
     total = sum(len(p) for p in parts)
     trace = Trace.allocate(parts[0], total)
@@ -226,11 +260,15 @@ def run_long(
             config = appraiser.config()
             short = dask.submit(_short_record, config, raw, channels[0], dt, pure=False)
             return short.result()
-        parts, peaks = _run_pieces(dask, plan, record, piece_samples, None)
+        parts, peaks = run_pieces(dask, plan, record, piece_samples)
+    check_peaks(appraiser, peaks, channels[0])
+    return gather(parts)
+
+
+def check_peaks(appraiser: CLPC, peaks: np.ndarray, n_in: int) -> None:
+    """The whole record's scale check of :meth:`clpc.CLPC.run`, from the channels' peaks."""
     if appraiser.noise_cov is None and appraiser.noise_ratio is None:
-        n_in = channels[0]
         check_spread(peaks[None, :n_in], peaks[None, n_in:], appraiser.scaling)
-    return _gather(parts)
 
 
 register_runner(is_dask_array, run_long)

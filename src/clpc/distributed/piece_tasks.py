@@ -16,6 +16,7 @@ Three tasks per piece, functions of picklable arguments:
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -196,18 +197,25 @@ def finish_piece(
     outputs: list[kernel.FsmOutput],
     plan: RecordPlan,
     path: str | None = None,
-) -> Trace | int:
-    """The piece's trace, or (with ``path``) its rows written to that Parquet file.
+    keep: tuple[str, ...] | None = None,
+) -> Trace:
+    """The piece's trace; with ``path`` its rows are written to that Parquet file first.
 
-    Returns
-    -------
-    Trace or int
-        The trace; with ``path``, the number of rows written.
+    Parameters
+    ----------
+    solved, outputs, plan
+        The piece's solved windows, FSM output and record plan.
+    path : str, optional
+        A Parquet file for the piece's rows (:class:`clpc.appraiser.tracefile.TraceWriter`).
+    keep : tuple of str, optional
+        Return only these per-update arrays (what a summary needs; default all).
     """
     trace = piece_trace(solved, outputs, plan)
-    if path is None:
+    if path is not None:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        with TraceWriter(path) as writer:
+            writer.write(trace)
+    if keep is None:
         return trace
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    with TraceWriter(path) as writer:
-        writer.write(trace)
-    return len(trace)
+    arrays = {k: v for k, v in trace.arrays.items() if k in keep}
+    return dataclasses.replace(trace, arrays=arrays)

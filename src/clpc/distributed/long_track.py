@@ -1,0 +1,154 @@
+"""A long record's trace written by the workers, and its summary from every update.
+
+:func:`track_long` appraises a ``.npy`` or Parquet record piece by piece on a Dask cluster
+(:mod:`clpc.distributed.long_record`). Each worker writes its piece's rows as one file of a
+partitioned Parquet dataset ``OUT/trace/part-NNNNNN.parquet`` (the columns of
+:func:`clpc.appraiser.tracefile.trace_columns`, in time order by file name; readable with
+``pandas.read_parquet("OUT/trace")`` or ``pyarrow.dataset``) and sends back only the
+per-update arrays the summary reads (about a third of a row). The summary
+(:func:`clpc.report.trace_summary`: counts, convergence, findings, the steady-state model)
+is computed from all updates and written to ``OUT/summary.json``.
+
+The dataset is written into a hidden folder and renamed to ``OUT/trace`` when every piece
+is complete: a failed or killed run leaves the previous dataset (or none), never a part.
+Every worker must see ``OUT`` at the same path (one machine, or a shared file system).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from clpc.appraiser import CLPC
+from clpc.core.atomic import write_file
+from clpc.data import DataError
+from clpc.distributed.cluster import dask_client
+from clpc.distributed.long_record import PIECE_SAMPLES, check_peaks, gather, plan_record, run_pieces
+from clpc.distributed.sources import NpySource, ParquetSource
+from clpc.model import LinearModel
+from clpc.report import steady_state, trace_summary
+
+__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long"]
+
+#: the per-update arrays that counts, convergence, findings and the steady-state model read
+#: (the same as ``clpc track`` keeps for its summary)
+SUMMARY_KEYS = (
+    "theta",
+    "D",
+    "c",
+    "accepted",
+    "has_model",
+    "trusted",
+    "determined",
+    "degenerate",
+    "excited",
+    "n_input_relations",
+    "stable",
+)
+
+
+@dataclass(frozen=True)
+class LongTrack:
+    """The outcome of :func:`track_long`.
+
+    Attributes
+    ----------
+    summary : dict
+        :func:`clpc.report.trace_summary` of every update.
+    model : LinearModel or None
+        The steady-state model (``None``: no update was accepted).
+    model_source : str
+        Where ``model`` comes from (see :func:`clpc.report.steady_state`).
+    dataset : Path
+        The folder of the trace's Parquet parts.
+    parts : int
+        Pieces (files of the dataset).
+    """
+
+    summary: dict[str, Any]
+    model: LinearModel | None
+    model_source: str
+    dataset: Path
+    parts: int
+
+
+def track_long(
+    appraiser: CLPC,
+    source: NpySource | ParquetSource,
+    out: str | os.PathLike[str],
+    *,
+    dt: float | None = None,
+    client: Any = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    piece_samples: int = PIECE_SAMPLES,
+) -> LongTrack:
+    """Appraise a record file on a Dask cluster; the workers write the trace as a dataset.
+
+    Parameters
+    ----------
+    appraiser : CLPC
+        The appraiser's settings (it is reset).
+    source : NpySource or ParquetSource
+        The record (:func:`clpc.distributed.open_source`).
+    out : path
+        Folder for ``trace/`` and ``summary.json`` (created).
+    dt : float, optional
+        The data's sample time [s] (default the appraiser's ``dt``).
+    client, scheduler, workers
+        Where to run (:func:`clpc.distributed.dask_client`).
+    piece_samples : int
+        Decimated samples per piece.
+
+    Returns
+    -------
+    LongTrack
+
+    Raises
+    ------
+    clpc.DataError
+        A record without a single update, a sample that is not finite, channels of
+        hopeless scales.
+    """
+    appraiser.reset()
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    channels = (len(source.inputs), len(source.outputs))
+    plan = plan_record(appraiser, channels, source.length(), dt, source.names())
+    if plan.layout.updates(plan.n_raw) == 0:
+        raise DataError(
+            f"{source.path}: {plan.n_raw} sample(s) give no cluster update with "
+            f"window_size={appraiser.window_size}, cluster_size={appraiser.cluster_size}; use "
+            "a longer record (or track it on one machine)."
+        )
+    staging = folder / f".trace-{uuid.uuid4().hex}"
+    try:
+        with dask_client(client, scheduler, workers) as dask:
+            parts, peaks = run_pieces(
+                dask, plan, source, piece_samples, (str(staging.resolve()), SUMMARY_KEYS)
+            )
+        check_peaks(appraiser, peaks, channels[0])
+        whole = gather(parts)
+        summary = trace_summary(whole)
+        _replace(staging, folder / "trace")
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    write_file(folder / "summary.json", json.dumps(summary, indent=1))
+    model, model_source = steady_state(whole)
+    return LongTrack(summary, model, model_source, folder / "trace", len(parts))
+
+
+def _replace(new: Path, target: Path) -> None:
+    """Rename the folder ``new`` to ``target``, removing a previous ``target`` folder."""
+    if target.is_symlink() or (target.exists() and not target.is_dir()):
+        raise DataError(f"{target} exists and is not a trace folder; remove it or pick --out.")
+    old = target.with_name(f".{target.name}-old-{uuid.uuid4().hex}")
+    if target.exists():
+        target.rename(old)
+    new.rename(target)
+    shutil.rmtree(old, ignore_errors=True)
