@@ -26,7 +26,7 @@ from clpc.appraiser.clpc import register_runner
 from clpc.appraiser.trace import Trace
 from clpc.data import DataError
 from clpc.data.samples import check_spread
-from clpc.distributed.cluster import dask_client
+from clpc.distributed.cluster import dask_client, require_distributed
 from clpc.distributed.piece_tasks import (
     RecordPlan,
     SolvedPiece,
@@ -42,6 +42,7 @@ __all__ = [
     "AHEAD",
     "PIECE_SAMPLES",
     "check_peaks",
+    "default_piece_samples",
     "gather",
     "is_dask_array",
     "plan_record",
@@ -49,8 +50,13 @@ __all__ = [
     "run_pieces",
 ]
 
-#: decimated samples per piece by default (about 1 s of one core's solving)
+#: most decimated samples per piece by default (about 1 s of one core's solving)
 PIECE_SAMPLES = 1 << 20
+#: pieces per worker the default piece size aims at (so that the workers stay busy)
+PIECES_PER_WORKER = 4
+#: fewest decimated samples per piece by default, in windows (the overlap read twice, at
+#: most ``W + max_lag``, stays below 2 % of a piece)
+MIN_PIECE_WINDOWS = 64
 #: pieces in flight per worker (solved, not yet finished)
 AHEAD = 3
 
@@ -116,7 +122,7 @@ def run_pieces(
     client: Any,
     plan: RecordPlan,
     record: Any,
-    piece_samples: int = PIECE_SAMPLES,
+    piece_samples: int | None = None,
     out: tuple[str, tuple[str, ...]] | None = None,
 ) -> tuple[list[Trace], np.ndarray]:
     """Run every piece of a record on ``client``.
@@ -127,8 +133,8 @@ def run_pieces(
     plan : RecordPlan
     record : source or (dask.array.Array, dask.array.Array)
         A file source, or inputs and outputs as 2-D dask arrays.
-    piece_samples : int
-        Decimated samples per piece.
+    piece_samples : int, optional
+        Decimated samples per piece; default :func:`default_piece_samples`.
     out : (str, tuple of str), optional
         ``(folder, keys)``: the workers write each piece's rows to
         ``folder/part-NNNNNN.parquet`` and return only the arrays ``keys``.
@@ -140,33 +146,73 @@ def run_pieces(
     peaks : ndarray, shape (channels,)
         The largest magnitude of every raw channel of the record.
     """
-    pieces = plan.layout.pieces(plan.n_raw, piece_samples)
+    n_workers = max(1, len(client.scheduler_info().get("workers", {})))
+    size = piece_samples or default_piece_samples(plan, n_workers)
+    pieces = plan.layout.pieces(plan.n_raw, size)
     if pieces:  # the last piece reads to the end (the whole record is checked)
         last = pieces[-1]
         pieces[-1] = last._replace(raw=(last.raw[0], plan.n_raw))
     read = _reader(record)
-    n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     limit = AHEAD * n_workers
     state: Any = plan.initial()
-    inflight: deque[tuple[Any, Any]] = deque()
-    results: list[Any] = []
+    solving: deque[tuple[Piece, Any]] = deque()
+    finishing: deque[tuple[Any, Any]] = deque()
+    results: list[Trace] = []
     peaks = np.zeros(sum(plan.channels))
     todo = deque(pieces)
-    while todo or inflight:
-        while todo and len(inflight) < limit:
+    while todo or solving or finishing:
+        while todo and len(solving) + len(finishing) < limit:
             piece = todo.popleft()
-            solved = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
-            outputs = client.submit(fsm_piece, solved, plan, state, pure=False)
-            state = client.submit(end_state, outputs, pure=False)
-            path = None if out is None else f"{out[0]}/part-{piece.number:06d}.parquet"
-            keep = None if out is None else out[1]
-            done = client.submit(finish_piece, solved, outputs, plan, path, keep, pure=False)
-            peak = client.submit(_peaks, solved, pure=False)
-            inflight.append((done, peak))
-        done, peak = inflight.popleft()
-        results.append(done.result())
-        peaks = np.maximum(peaks, peak.result())
+            raw = read(client, piece)
+            solving.append((piece, client.submit(solve_piece, raw, plan, piece, pure=False)))
+        if solving:  # the oldest solved piece: its FSM pass and rows where it lies
+            piece, solved = solving.popleft()
+            state, done, peak = _chain(client, (plan, piece, solved), state, out)
+            finishing.append((done, peak))
+        if finishing and (finishing[0][0].done() or not solving):
+            done, peak = finishing.popleft()
+            results.append(done.result())
+            peaks = np.maximum(peaks, peak.result())
     return results, peaks
+
+
+def _chain(
+    client: Any, job: tuple[RecordPlan, Piece, Any], state: Any, out: tuple[str, Any] | None
+) -> tuple[Any, Any, Any]:
+    """Submit a solved piece's FSM pass (after the previous piece's), rows and peaks.
+
+    They run on the worker that holds the solved piece (a preference: another worker takes
+    them if that one is lost), so only the few numbers of the FSM state move between
+    workers. Returns the futures of the end state, the rows and the peaks.
+    """
+    plan, piece, solved = job
+    distributed = require_distributed()
+    distributed.wait(solved)
+    if solved.status == "error":
+        solved.result()  # raises the worker's error (e.g. a sample that is not finite)
+    where = list(client.who_has(solved).get(solved.key, ()))
+    kw: dict[str, Any] = {"pure": False}
+    if where:
+        kw.update(workers=where, allow_other_workers=True)
+    outputs = client.submit(fsm_piece, solved, plan, state, **kw)
+    path = None if out is None else f"{out[0]}/part-{piece.number:06d}.parquet"
+    keep = None if out is None else out[1]
+    done = client.submit(finish_piece, solved, outputs, plan, path, keep, **kw)
+    return (
+        client.submit(end_state, outputs, **kw),
+        done,
+        client.submit(_peaks, solved, **kw),
+    )
+
+
+def default_piece_samples(plan: RecordPlan, n_workers: int) -> int:
+    """Decimated samples per piece by default.
+
+    :data:`PIECES_PER_WORKER` pieces per worker, at most :data:`PIECE_SAMPLES` samples, at
+    least :data:`MIN_PIECE_WINDOWS` windows.
+    """
+    share = plan.layout.kept(plan.n_raw) // (PIECES_PER_WORKER * n_workers)
+    return max(min(share, PIECE_SAMPLES), MIN_PIECE_WINDOWS * plan.layout.window)
 
 
 def _peaks(solved: SolvedPiece) -> np.ndarray:
@@ -202,7 +248,7 @@ def run_long(
     client: Any = None,
     scheduler: str | None = None,
     workers: int | None = None,
-    piece_samples: int = PIECE_SAMPLES,
+    piece_samples: int | None = None,
 ) -> Trace:
     """:meth:`clpc.CLPC.run` over a record split into pieces on a Dask cluster.
 
@@ -220,8 +266,9 @@ def run_long(
     client, scheduler, workers
         Where to run (:func:`clpc.distributed.dask_client`): a client, a scheduler's
         address, or a local cluster of ``workers`` processes.
-    piece_samples : int
-        Decimated samples per piece (each piece also reads up to ``W + max_lag`` before).
+    piece_samples : int, optional
+        Decimated samples per piece (each piece also reads up to ``W + max_lag`` before);
+        default :func:`default_piece_samples`.
 
     Returns
     -------

@@ -28,7 +28,7 @@ from clpc.appraiser import CLPC
 from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
-from clpc.distributed.long_record import PIECE_SAMPLES, check_peaks, gather, plan_record, run_pieces
+from clpc.distributed.long_record import check_peaks, gather, plan_record, run_pieces
 from clpc.distributed.sources import NpySource, ParquetSource
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
@@ -86,7 +86,7 @@ def track_long(
     client: Any = None,
     scheduler: str | None = None,
     workers: int | None = None,
-    piece_samples: int = PIECE_SAMPLES,
+    piece_samples: int | None = None,
 ) -> LongTrack:
     """Appraise a record file on a Dask cluster; the workers write the trace as a dataset.
 
@@ -102,8 +102,9 @@ def track_long(
         The data's sample time [s] (default the appraiser's ``dt``).
     client, scheduler, workers
         Where to run (:func:`clpc.distributed.dask_client`).
-    piece_samples : int
-        Decimated samples per piece.
+    piece_samples : int, optional
+        Decimated samples per piece (default
+        :func:`clpc.distributed.long_record.default_piece_samples`).
 
     Returns
     -------

@@ -39,6 +39,7 @@ __all__ = [
     "finish_piece",
     "fsm_piece",
     "solve_piece",
+    "trace_nbytes",
 ]
 
 #: the carried FSM state: last accepted theta (E, p), its c (E,), has-a-model flags (E,)
@@ -85,6 +86,20 @@ class RecordPlan:
         p = self.state().n_params()
         n_out = self.channels[1]
         return np.zeros((n_out, p)), np.zeros(n_out), np.zeros(n_out, dtype=bool)
+
+
+def trace_nbytes(trace: Trace) -> int:
+    """Bytes of a trace's arrays (what Dask counts for a task that returns one)."""
+    plain = (trace.index, trace.time, trace.rows, trace.not_enough_data)
+    return sum(a.nbytes for a in plain) + sum(a.nbytes for a in trace.arrays.values())
+
+
+try:  # Dask's memory accounting sizes a returned trace by its arrays
+    from dask.sizeof import sizeof
+except ImportError:  # pragma: no cover - the distributed extra is installed in the tests
+    pass
+else:
+    sizeof.register(Trace)(trace_nbytes)
 
 
 class SolvedPiece(NamedTuple):
