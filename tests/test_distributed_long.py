@@ -218,3 +218,30 @@ def test_the_workers_write_the_trace_as_a_dataset_and_the_summary_reads_all_of_i
     expected = trace_summary(ref)
     assert result.summary == expected
     assert result.model is not None and result.model_source == expected["model_source"]
+
+
+def test_clpc_track_workers_writes_what_clpc_track_writes(tmp_path):
+    import pandas as pd
+    from click.testing import CliRunner
+
+    from clpc.cli import cli
+
+    u, y = _record(24_001)
+    np.save(tmp_path / "rec.npy", np.column_stack([u, y]))
+    common = ["track", str(tmp_path / "rec.npy"), "-u", "0", "-y", "1", "--dt", "0.01"]
+    common += ["--window-size", "120", "--cluster-size", "10"]
+    runner = CliRunner()
+    one = runner.invoke(cli, [*common, "--out", str(tmp_path / "one"), "--format", "parquet"])
+    assert one.exit_code == 0, one.output
+    two = runner.invoke(cli, [*common, "--out", str(tmp_path / "two"), "--workers", "2"])
+    assert two.exit_code == 0, two.output
+    single = pd.read_parquet(tmp_path / "one" / "trace.parquet")
+    spread = pd.read_parquet(tmp_path / "two" / "trace").sort_values("index")
+    assert list(spread.columns) == list(single.columns)
+    assert np.array_equal(spread.to_numpy(dtype=float), single.to_numpy(dtype=float))
+    # the same summary and model printed (the files written differ)
+    printed = [line for line in one.output.splitlines() if not line.startswith("wrote")]
+    assert [line for line in two.output.splitlines() if line in printed] == printed
+    bad = runner.invoke(cli, [*common[:2], "--workers", "2", "-u", "0", "-y", "1", "--time", "t",
+                              "--out", str(tmp_path / "x")])  # fmt: skip
+    assert bad.exit_code != 0 and "--dt" in bad.output

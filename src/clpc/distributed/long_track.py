@@ -29,11 +29,13 @@ from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
 from clpc.distributed.long_record import check_peaks, gather, plan_record, run_pieces
-from clpc.distributed.sources import NpySource, ParquetSource
+from clpc.distributed.sources import NpySource, ParquetSource, open_source
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
+from clpc.workflows import TrackSettings
+from clpc.workflows.common import SettingsError
 
-__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long"]
+__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
 
 #: the per-update arrays that counts, convergence, findings and the steady-state model read
 #: (the same as ``clpc track`` keeps for its summary)
@@ -142,6 +144,48 @@ def track_long(
     write_file(folder / "summary.json", json.dumps(summary, indent=1))
     model, model_source = steady_state(whole)
     return LongTrack(summary, model, model_source, folder / "trace", len(parts))
+
+
+def track_settings(
+    settings: TrackSettings,
+    *,
+    client: Any = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+) -> LongTrack:
+    """:func:`track_long` from the settings of ``clpc track`` (``--workers``/``--scheduler``).
+
+    The record, its columns, ``--dt``, the appraiser's settings and ``--out`` are those of
+    the command.
+
+    Raises
+    ------
+    SettingsError
+        A time column (give ``--dt``), or a file that is not ``.npy`` or Parquet.
+    """
+    record = settings.record
+    if record.time_col is not None:
+        raise SettingsError(
+            "a record split over workers needs a uniform sample time given with --dt "
+            "(a time column is checked chunk by chunk on one machine: drop --workers/"
+            "--scheduler, or give --dt instead of --time)."
+        )
+    try:
+        keys = record.columns()  # digits as 0-based positions, as clpc track reads them
+        n_in, n_out = len(record.inputs), len(record.outputs)
+        source = open_source(record.file, tuple(keys[:n_in]), tuple(keys[n_in : n_in + n_out]))
+    except DataError as exc:
+        raise SettingsError(str(exc)) from None
+    appraiser = settings.appraiser.build(record.dt)
+    return track_long(
+        appraiser,
+        source,
+        settings.out_dir,
+        dt=record.dt,
+        client=client,
+        scheduler=scheduler,
+        workers=workers,
+    )
 
 
 def _replace(new: Path, target: Path) -> None:
