@@ -239,9 +239,12 @@ def test_clpc_track_workers_writes_what_clpc_track_writes(tmp_path):
     spread = pd.read_parquet(tmp_path / "two" / "trace").sort_values("index")
     assert list(spread.columns) == list(single.columns)
     assert np.array_equal(spread.to_numpy(dtype=float), single.to_numpy(dtype=float))
-    # the same summary and model printed (the files written differ)
+    # the same summary, advice and model printed; the same report files beside the dataset
     printed = [line for line in one.output.splitlines() if not line.startswith("wrote")]
     assert [line for line in two.output.splitlines() if line in printed] == printed
+    figures = {p.name for p in (tmp_path / "one").iterdir() if p.suffix in (".png", ".html")}
+    assert "report.html" in figures
+    assert figures <= {p.name for p in (tmp_path / "two").iterdir()}
     bad = runner.invoke(cli, [*common[:2], "--workers", "2", "-u", "0", "-y", "1", "--time", "t",
                               "--out", str(tmp_path / "x")])  # fmt: skip
     assert bad.exit_code != 0 and "--dt" in bad.output

@@ -100,17 +100,16 @@ def _track_distributed(settings: TrackSettings, workers: int | None, scheduler: 
     from clpc.distributed import dask_client
 
     with dask_client(None, scheduler, workers, announce) as client:
-        done = track_settings(settings, client=client)
-    files = [done.dataset, done.dataset.parent / "summary.json"]
+        result, done = track_settings(settings, client=client)
     refused = None
-    if settings.save and done.model is not None:
-        refused = save_refusal(done.model, settings.save)
+    if settings.save and result.model is not None:
+        refused = save_refusal(result.model, settings.save)
         if refused is None:
-            save_model(done.model, settings.save)
-            files.append(Path(settings.save))
-    _print_result(TrackResult(done.summary, done.model, done.model_source, files, refused))
-    click.echo(f"({done.parts} pieces; the trace is a Parquet dataset: one file per piece)")
-    if settings.save and done.model is None:
+            save_model(result.model, settings.save)
+            result.files.append(Path(settings.save))
+    _print_result(result)
+    click.echo(f"({done.parts} pieces; the trace is a Parquet dataset, one file per piece)")
+    if settings.save and result.model is None:
         raise click.ClickException(
             f"no update was accepted: there is no model to save to {settings.save}."
         )

@@ -16,6 +16,7 @@ Every worker must see ``OUT`` at the same path (one machine, or a shared file sy
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import shutil
@@ -24,19 +25,28 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from clpc.appraiser import CLPC
+from clpc.appraiser.decimation import Decimator
 from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
-from clpc.distributed.long_record import check_peaks, gather, plan_record, run_pieces
+from clpc.distributed.long_record import check_peaks, gather, plan_record
+from clpc.distributed.piece_tasks import RecordPlan, take_rows, write_piece
+from clpc.distributed.pieces import warmup
+from clpc.distributed.schedule import run_pieces
 from clpc.distributed.sources import NpySource, ParquetSource, open_source
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
 from clpc.workflows import TrackSettings
 from clpc.workflows.common import SettingsError
+from clpc.workflows.track import REPORT_SAMPLES, Appraised, TrackResult, write_report
 
 __all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
 
+#: the last updates the report's table shows (as ``clpc track``'s)
+RECENT = 20
 #: the per-update arrays that counts, convergence, findings and the steady-state model read
 #: (the same as ``clpc track`` keeps for its summary)
 SUMMARY_KEYS = (
@@ -70,6 +80,8 @@ class LongTrack:
         The folder of the trace's Parquet parts.
     parts : int
         Pieces (files of the dataset).
+    appraised : Appraised
+        What a report is made of (:func:`clpc.workflows.track.write_report`).
     """
 
     summary: dict[str, Any]
@@ -77,6 +89,7 @@ class LongTrack:
     model_source: str
     dataset: Path
     parts: int
+    appraised: Appraised
 
 
 def track_long(
@@ -89,6 +102,8 @@ def track_long(
     scheduler: str | None = None,
     workers: int | None = None,
     piece_samples: int | None = None,
+    figure_updates: int = 20_000,
+    window_levels: bool = True,
 ) -> LongTrack:
     """Appraise a record file on a Dask cluster; the workers write the trace as a dataset.
 
@@ -107,6 +122,12 @@ def track_long(
     piece_samples : int, optional
         Decimated samples per piece (default
         :func:`clpc.distributed.long_record.default_piece_samples`).
+    figure_updates : int
+        The report's figures show at most about twice this many updates (as ``clpc track``).
+    window_levels : bool
+        Keep the windows' levels (``meta["window_level"]``, as :meth:`clpc.CLPC.run`) for
+        the summary's findings; ``False``: without them, as ``clpc track`` (which reads a
+        record in chunks) summarises.
 
     Returns
     -------
@@ -123,27 +144,65 @@ def track_long(
     folder.mkdir(parents=True, exist_ok=True)
     channels = (len(source.inputs), len(source.outputs))
     plan = plan_record(appraiser, channels, source.length(), dt, source.names())
-    if plan.layout.updates(plan.n_raw) == 0:
+    total = plan.layout.updates(plan.n_raw)
+    if total == 0:
         raise DataError(
             f"{source.path}: {plan.n_raw} sample(s) give no cluster update with "
             f"window_size={appraiser.window_size}, cluster_size={appraiser.cluster_size}; use "
             "a longer record (or track it on one machine)."
         )
     staging = folder / f".trace-{uuid.uuid4().hex}"
+    stride = thinning_stride(total, figure_updates)
+    finish = (write_piece, (str(staging.resolve()), SUMMARY_KEYS, (stride, RECENT)))
     try:
         with dask_client(client, scheduler, workers) as dask:
-            parts, peaks = run_pieces(
-                dask, plan, source, piece_samples, (str(staging.resolve()), SUMMARY_KEYS)
-            )
+            parts, peaks = run_pieces(dask, plan, source, piece_samples, finish)
+            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False).result()
         check_peaks(appraiser, peaks, channels[0])
-        whole = gather(parts)
+        whole = gather([p.summary for p in parts])
+        if not window_levels:
+            meta = {k: v for k, v in whole.meta.items() if k != "window_level"}
+            whole = dataclasses.replace(whole, meta=meta)
         summary = trace_summary(whole)
         _replace(staging, folder / "trace")
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     write_file(folder / "summary.json", json.dumps(summary, indent=1))
     model, model_source = steady_state(whole)
-    return LongTrack(summary, model, model_source, folder / "trace", len(parts))
+    figures = gather([p.figures for p in parts])
+    figures = dataclasses.replace(
+        figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
+    )
+    last = gather([p.last for p in parts[-2:]])
+    recent = take_rows(last, np.arange(max(len(last) - RECENT, 0), len(last)))
+    n_kept = plan.layout.kept(plan.n_raw)
+    done = Appraised(appraiser.config(), n_kept, figures, whole, recent, tail)
+    return LongTrack(summary, model, model_source, folder / "trace", len(parts), done)
+
+
+def thinning_stride(updates: int, figure_updates: int) -> int:
+    """The stride :class:`clpc.appraiser.thinned.ThinnedTrace` ends with for ``updates``.
+
+    The smallest power of two ``s`` with ``ceil(updates / s) <= 2 * figure_updates``.
+    """
+    stride = 1
+    while -(-updates // stride) > 2 * figure_updates:
+        stride *= 2
+    return stride
+
+
+def tail_samples(source: NpySource | ParquetSource, plan: RecordPlan, n: int) -> np.ndarray:
+    """The record's last ``n`` samples at the appraiser's rate, ``[inputs | outputs]``.
+
+    Read on a worker; with decimation the filter starts :func:`.pieces.warmup` samples
+    before (the values agree with ``clpc track``'s to rounding).
+    """
+    lay = plan.layout
+    first = max(0, lay.kept(plan.n_raw) - n)
+    lo = max(0, first * lay.factor - warmup(lay.factor))
+    raw = source.read(lo, plan.n_raw)
+    kept = Decimator(lay.factor)(raw) if lay.factor > 1 else raw
+    return np.array(kept[first - lo // lay.factor :], dtype=np.float64)
 
 
 def track_settings(
@@ -152,11 +211,12 @@ def track_settings(
     client: Any = None,
     scheduler: str | None = None,
     workers: int | None = None,
-) -> LongTrack:
-    """:func:`track_long` from the settings of ``clpc track`` (``--workers``/``--scheduler``).
+) -> tuple[TrackResult, LongTrack]:
+    """``clpc track`` with ``--workers``/``--scheduler``: :func:`track_long`, then the report.
 
     The record, its columns, ``--dt``, the appraiser's settings and ``--out`` are those of
-    the command.
+    the command; ``OUT`` gets ``trace/`` (the dataset), ``summary.json``, the figures and
+    ``report.html`` of :func:`clpc.workflows.track.write_report`.
 
     Raises
     ------
@@ -176,16 +236,22 @@ def track_settings(
         source = open_source(record.file, tuple(keys[:n_in]), tuple(keys[n_in : n_in + n_out]))
     except DataError as exc:
         raise SettingsError(str(exc)) from None
-    appraiser = settings.appraiser.build(record.dt)
-    return track_long(
-        appraiser,
+    done = track_long(
+        settings.appraiser.build(record.dt),
         source,
         settings.out_dir,
         dt=record.dt,
         client=client,
         scheduler=scheduler,
         workers=workers,
+        figure_updates=settings.figure_updates,
+        window_levels=False,
     )
+    out = Path(settings.out_dir)
+    result = write_report(settings, done.appraised, done.dataset, out)
+    write_file(out / "summary.json", json.dumps(result.summary, indent=1))
+    files = [*result.files, out / "summary.json"]
+    return dataclasses.replace(result, files=files), done
 
 
 def _replace(new: Path, target: Path) -> None:

@@ -11,7 +11,9 @@ Three tasks per piece, functions of picklable arguments:
    (:func:`clpc.appraiser.kernel.output`) over the piece's windows in time order, starting
    from the state the previous piece ended in; :func:`end_state` is that state (a few
    numbers), all the next piece needs;
-3. :func:`finish_piece` (parallel): the piece's trace rows, returned or written to a file.
+3. :func:`finish_piece` (parallel): the piece's trace rows; or :func:`write_piece`: the rows
+   written to one file of a Parquet dataset, and only what a summary and a report need
+   returned.
 """
 
 from __future__ import annotations
@@ -35,11 +37,14 @@ from clpc.distributed.pieces import Layout, Piece
 __all__ = [
     "RecordPlan",
     "SolvedPiece",
+    "WrittenPiece",
     "end_state",
     "finish_piece",
     "fsm_piece",
     "solve_piece",
+    "take_rows",
     "trace_nbytes",
+    "write_piece",
 ]
 
 #: the carried FSM state: last accepted theta (E, p), its c (E,), has-a-model flags (E,)
@@ -207,30 +212,68 @@ def piece_trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: Reco
     return trace
 
 
-def finish_piece(
+def finish_piece(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
+    """The piece's trace rows (what :meth:`clpc.CLPC.run` returns for these updates)."""
+    return piece_trace(solved, outputs, plan)
+
+
+class WrittenPiece(NamedTuple):
+    """What a worker sends back of a piece whose rows it wrote (small)."""
+
+    summary: Trace  #: every update, the arrays a summary reads only
+    figures: Trace  #: every ``stride``-th update of the record (all arrays)
+    last: Trace  #: the piece's last updates (all arrays)
+
+
+def write_piece(
     solved: SolvedPiece,
     outputs: list[kernel.FsmOutput],
     plan: RecordPlan,
-    path: str | None = None,
-    keep: tuple[str, ...] | None = None,
-) -> Trace:
-    """The piece's trace; with ``path`` its rows are written to that Parquet file first.
+    folder: str,
+    keep: tuple[str, ...],
+    thin: tuple[int, int],
+) -> WrittenPiece:
+    """Write the piece's rows to ``folder/part-NNNNNN.parquet``; return what a report needs.
 
     Parameters
     ----------
     solved, outputs, plan
         The piece's solved windows, FSM output and record plan.
-    path : str, optional
-        A Parquet file for the piece's rows (:class:`clpc.appraiser.tracefile.TraceWriter`).
-    keep : tuple of str, optional
-        Return only these per-update arrays (what a summary needs; default all).
+    folder : str
+        The dataset's folder (the file is named by the piece's number).
+    keep : tuple of str
+        The per-update arrays of :attr:`WrittenPiece.summary`.
+    thin : (int, int)
+        ``(stride, last)``: the figures take the updates ``j`` with ``(j - 1) % stride ==
+        0`` (as :class:`clpc.appraiser.thinned.ThinnedTrace` keeps them); ``last`` updates
+        are returned from the piece's end.
     """
     trace = piece_trace(solved, outputs, plan)
-    if path is not None:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        with TraceWriter(path) as writer:
-            writer.write(trace)
-    if keep is None:
-        return trace
+    path = Path(folder) / f"part-{solved.piece.number:06d}.parquet"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with TraceWriter(path) as writer:
+        writer.write(trace)
+    stride, last = thin
+    numbers = np.arange(solved.piece.j_lo - 1, solved.piece.j_hi)
     arrays = {k: v for k, v in trace.arrays.items() if k in keep}
-    return dataclasses.replace(trace, arrays=arrays)
+    return WrittenPiece(
+        dataclasses.replace(trace, arrays=arrays),
+        take_rows(trace, np.flatnonzero(numbers % stride == 0)),
+        take_rows(trace, np.arange(max(len(trace) - last, 0), len(trace))),
+    )
+
+
+def take_rows(trace: Trace, rows: np.ndarray) -> Trace:
+    """The updates ``rows`` of a trace (``meta["window_level"]`` taken along)."""
+    meta = dict(trace.meta)
+    if "window_level" in meta:
+        meta["window_level"] = meta["window_level"][rows]
+    return dataclasses.replace(
+        trace,
+        index=trace.index[rows],
+        time=trace.time[rows],
+        rows=trace.rows[rows],
+        not_enough_data=trace.not_enough_data[rows],
+        arrays={k: v[rows] for k, v in trace.arrays.items()},
+        meta=meta,
+    )
