@@ -218,6 +218,25 @@ def test_the_workers_write_the_trace_as_a_dataset_and_the_summary_reads_all_of_i
     expected = trace_summary(ref)
     assert result.summary == expected
     assert result.model is not None and result.model_source == expected["model_source"]
+    # what the report is made of: the updates clpc track's thinning keeps, the last ones,
+    # the record's last samples
+    from clpc.appraiser.tracefile import ThinnedTrace
+    from clpc.workflows.track import REPORT_SAMPLES
+
+    thin = ThinnedTrace(300)
+    thin.add(ref)
+    small = track_long(CLPC(**settings), source, tmp_path / "o2", client=client,
+                       piece_samples=1_500, figure_updates=300)  # fmt: skip
+    figures, want = small.appraised.figures, thin.trace()
+    assert want.meta["thinned_stride"] > 1
+    assert figures.meta["thinned_stride"] == want.meta["thinned_stride"]
+    assert figures.meta["updates_total"] == want.meta["updates_total"] == len(ref)
+    assert np.array_equal(figures.index, want.index)
+    for key, value in want.arrays.items():
+        assert np.array_equal(figures.arrays[key], value), key
+    assert np.array_equal(small.appraised.recent.index, ref.index[-20:])
+    assert np.array_equal(small.appraised.tail, np.column_stack([u, y])[-REPORT_SAMPLES:])
+    assert small.appraised.n_samples == u.size
 
 
 def test_clpc_track_workers_writes_what_clpc_track_writes(tmp_path):
