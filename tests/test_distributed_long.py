@@ -129,6 +129,10 @@ def test_clpc_run_takes_a_dask_array_and_multichannel_records(client):
         da.from_array(u, chunks=(2_000, 2)), da.from_array(y, chunks=(3_000, 2))
     )
     _assert_same(ref, got)
+    # one of the two in memory (it goes to the workers as a dask array)
+    got = run_long(CLPC(order=1, window_size=80, cluster_size=9), u, da.from_array(y),
+                   client=client, piece_samples=2_000)  # fmt: skip
+    _assert_same(ref, got)
 
 
 def test_decimation_agrees_to_rounding_and_the_warmup_is_what_makes_it(client):

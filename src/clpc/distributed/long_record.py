@@ -154,6 +154,10 @@ def run_long(
         channels = (len(u.inputs), len(u.outputs))
         n_raw, names = u.length(), u.names()
     else:
+        import dask.array as da
+
+        # one of them in memory: sliced by Dask like the other
+        u, y = (x if is_dask_array(x) else da.from_array(np.asarray(x)) for x in (u, y))
         u2, y2 = _columns(u, "u"), _columns(y, "y")
         if u2.shape[0] != y2.shape[0]:
             raise DataError(
