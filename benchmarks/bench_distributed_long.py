@@ -14,7 +14,8 @@ Runs, all in one invocation:
   processes (one thread each): the workers read their memory-mapped slices of the ``.npy``
   file; the trace's rows come back to this process (as ``run`` returns them);
 * ``track_long N``: :func:`clpc.distributed.track_long`: the workers write the trace as a
-  partitioned Parquet dataset; only the arrays of the summary come back.
+  partitioned Parquet dataset; only the arrays of the summary, the updates of the report's
+  figures and the last updates come back (Dask's size estimates of the results).
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
 kernel is loaded in each worker), then timed. The ``run_long`` trace is compared with the
@@ -168,9 +169,9 @@ def distributed_runs(
             seconds = _task_seconds(ts.data)
             pieces = sum(1 for t in ts.data if str(t["key"]).startswith("solve_piece"))
             computing = sum(seconds.values())
-            if to_client is None:  # summary arrays: sizes reported by the task stream
+            if to_client is None:  # summary, figures, last rows: Dask's sizes of the results
                 to_client = sum(
-                    t["nbytes"] for t in ts.data if str(t["key"]).startswith("finish_piece")
+                    t["nbytes"] for t in ts.data if str(t["key"]).startswith("write_piece")
                 )
             worker_rss = client.run(
                 lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -197,6 +198,7 @@ def distributed_runs(
 def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     secs, wall = row["seconds"], row["wall"]
     chain = secs.get("fsm_piece", 0.0) + secs.get("end_state", 0.0)
+    finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
     print(
         f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
         f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x  "
@@ -205,7 +207,7 @@ def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     print(
         f"    {row['pieces']} pieces; computing {sum(secs.values()):.2f} s (solve "
         f"{secs.get('solve_piece', 0.0):.2f}, sequential FSM chain {chain:.2f} = "
-        f"{100 * chain / wall:.1f} % of the wall time, finish {secs.get('finish_piece', 0.0):.2f})"
+        f"{100 * chain / wall:.1f} % of the wall time, finish {finish:.2f})"
         f"; scheduler overhead per piece {1e3 * row['overhead_per_piece']:.1f} ms"
     )
     print(
