@@ -97,6 +97,27 @@ def gather(parts: list[Trace]) -> Trace:
     return trace
 
 
+class _Joined:
+    """A record's trace filled piece by piece as the pieces arrive (one copy in memory)."""
+
+    def __init__(self, total: int) -> None:
+        self.total = total
+        self.trace: Trace | None = None
+        self.done = 0
+        self.levels: list[np.ndarray] = []
+
+    def add(self, part: Trace) -> None:
+        if self.trace is None:
+            self.trace = Trace.allocate(part, self.total)
+        self.done = self.trace.put(self.done, part)
+        self.levels.append(part.meta["window_level"])
+
+    def result(self) -> Trace:
+        assert self.trace is not None and self.done == self.total, (self.done, self.total)
+        self.trace.meta["window_level"] = np.concatenate(self.levels)
+        return self.trace
+
+
 def _short_record(config: dict[str, Any], raw: Any, n_in: int, dt: float | None) -> Trace:
     """A record without a single update, read and appraised on a worker as it is."""
     if isinstance(raw, tuple):
@@ -177,9 +198,10 @@ def run_long(
             config = appraiser.config()
             short = dask.submit(_short_record, config, raw, channels[0], dt, pure=False)
             return short.result()
-        parts, peaks = run_pieces(dask, plan, record, piece_samples)
+        joined = _Joined(plan.layout.updates(n_raw))
+        _, peaks = run_pieces(dask, plan, record, piece_samples, sink=joined.add)
     check_peaks(appraiser, peaks, channels[0])
-    return gather(parts)
+    return joined.result()
 
 
 def check_peaks(appraiser: CLPC, peaks: np.ndarray, n_in: int) -> None:

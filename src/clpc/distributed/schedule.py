@@ -65,6 +65,7 @@ def run_pieces(
     record: Any,
     piece_samples: int | None = None,
     finish: tuple[Callable[..., Any], tuple[Any, ...]] = (finish_piece, ()),
+    sink: Callable[[Any], None] | None = None,
 ) -> tuple[list[Any], np.ndarray]:
     """Run every piece of a record on ``client``.
 
@@ -80,10 +81,14 @@ def run_pieces(
         ``(function, args)``: the last task of a piece, ``function(solved, outputs, plan,
         *args)`` (default :func:`.piece_tasks.finish_piece`: the piece's trace).
 
+    sink : callable, optional
+        Called with what ``finish`` returned for each piece, in time order, as it arrives
+        (then not kept: ``parts`` is empty).
+
     Returns
     -------
     parts : list
-        What ``finish`` returned for each piece, in time order.
+        What ``finish`` returned for each piece, in time order (without ``sink``).
     peaks : ndarray, shape (channels,)
         The largest magnitude of every raw channel of the record.
     """
@@ -99,6 +104,7 @@ def run_pieces(
     solving: deque[tuple[Piece, Any]] = deque()
     finishing: deque[tuple[Any, Any]] = deque()
     results: list[Any] = []
+    take = results.append if sink is None else sink
     peaks = np.zeros(sum(plan.channels))
     todo = deque(pieces)
     while todo or solving or finishing:
@@ -112,7 +118,7 @@ def run_pieces(
             finishing.append((done, peak))
         if finishing and (finishing[0][0].done() or not solving):
             done, peak = finishing.popleft()
-            results.append(done.result())
+            take(done.result())
             peaks = np.maximum(peaks, peak.result())
     return results, peaks
 
