@@ -45,9 +45,29 @@ from clpc.core.atomic import atomic_file
 from clpc.core.rules import RobustRule
 from clpc.data.samples import check_spread
 
-__all__ = ["CLPC"]
+__all__ = ["CLPC", "register_runner"]
 
 _LOG = logging.getLogger("clpc.appraiser")
+
+
+#: runners of records that are not arrays in memory (e.g. a ``dask.array``), registered by
+#: the layers above (:mod:`clpc.distributed.long_record`): ``(accepts(x), run(appraiser, u,
+#: y, dt))``; :meth:`CLPC.run` hands a record to the first that accepts ``u`` or ``y``
+_RUNNERS: list[tuple[Callable[[Any], bool], Callable[..., Trace]]] = []
+
+
+def register_runner(accepts: Callable[[Any], bool], run: Callable[..., Trace]) -> None:
+    """Let :meth:`CLPC.run` hand records that ``accepts`` to ``run(appraiser, u, y, dt)``.
+
+    Parameters
+    ----------
+    accepts : callable
+        ``accepts(u_or_y)``: whether the runner takes this record.
+    run : callable
+        ``run(appraiser, u, y, dt)``, returning the :class:`Trace` ``run`` would return.
+    """
+    if (accepts, run) not in _RUNNERS:
+        _RUNNERS.append((accepts, run))
 
 
 def _setting(name: str, doc: str) -> Any:
@@ -300,7 +320,16 @@ class CLPC:
         -------
         Trace
             One row per update.
+
+        Notes
+        -----
+        A ``dask.array`` record is appraised piece by piece on a Dask cluster once
+        :mod:`clpc.distributed` is imported (:func:`clpc.distributed.run_long`; the same
+        trace).
         """
+        for accepts, runner in _RUNNERS:
+            if accepts(u) or accepts(y):
+                return runner(self, u, y, dt)
         s = self.reset()._state
         u_arr, y_arr, data_dt, names = as_record(u, y, dt)
         s.init_channels(u_arr.shape[1], y_arr.shape[1], names)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import click
 
@@ -87,6 +88,35 @@ def _print_result(result: TrackResult) -> None:
         click.echo(f"wrote {f}")
 
 
+def _track_distributed(settings: TrackSettings, workers: int | None, scheduler: str | None) -> None:
+    """The record split into pieces on a Dask cluster (``docs/distributed-long.md``)."""
+    from clpc.distributed.long_track import track_settings
+    from clpc.io import save_model
+    from clpc.workflows.save_check import save_refusal
+
+    def announce(line: str) -> None:
+        click.echo(line, err=True)
+
+    from clpc.distributed import dask_client
+
+    with dask_client(None, scheduler, workers, announce) as client:
+        result, done = track_settings(settings, client=client)
+    refused = None
+    if settings.save and result.model is not None:
+        refused = save_refusal(result.model, settings.save)
+        if refused is None:
+            save_model(result.model, settings.save)
+            result.files.append(Path(settings.save))
+    _print_result(result)
+    click.echo(f"({done.parts} pieces; the trace is a Parquet dataset, one file per piece)")
+    if settings.save and result.model is None:
+        raise click.ClickException(
+            f"no update was accepted: there is no model to save to {settings.save}."
+        )
+    if refused:
+        raise click.ClickException(refused)
+
+
 @click.command(cls=ClpcCommand)
 @file_argument()
 @input_option()
@@ -108,11 +138,27 @@ def _print_result(result: TrackResult) -> None:
     help="Progress on standard error: a bar on a terminal, one line per chunk into a pipe "
     "(default: only on a terminal).",
 )
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Split the record (.npy or Parquet) over a local Dask cluster of N worker "
+    "processes; the workers write OUT/trace/ as a Parquet dataset and OUT/summary.json.",
+)
+@click.option(
+    "--scheduler",
+    "scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="As --workers, on the running Dask scheduler at ADDRESS (e.g. tcp://host:8786).",
+)
 @save_option("Save the steady-state model.")
 @record_settings()
 @appraiser_settings()
 @collect("settings", TrackSettings)
-def track(settings: TrackSettings, progress: bool | None) -> None:
+def track(
+    settings: TrackSettings, progress: bool | None, workers: int | None, scheduler: str | None
+) -> None:
     """Run the CLPC appraiser over a record (read in chunks) and write a trace and a report.
 
     Writes OUT/trace.csv (one row per cluster update: theta, monic den/num, D, flags),
@@ -126,6 +172,9 @@ def track(settings: TrackSettings, progress: bool | None) -> None:
       clpc track big.parquet -u u -y y --dt 0.001 --decimate-to 0.01 --out run2/ --progress
     """  # noqa: D301
     warn_unnamed_time(settings.record)
+    if workers is not None or scheduler is not None:
+        _track_distributed(settings, workers, scheduler)
+        return
     show = progress if progress is not None else sys.stderr.isatty()
     bar = _progress_bar(settings.record.file, settings.record.skip_rows) if show else None
     result = track_file(settings, bar)

@@ -38,7 +38,9 @@ __all__ = [
     "MAX_SPREAD",
     "MIN_MAGNITUDE",
     "as_samples",
+    "channel_ranges",
     "check_magnitude",
+    "check_ranges",
     "check_spread",
 ]
 
@@ -213,22 +215,24 @@ def check_magnitude(arr: np.ndarray, name: str) -> None:
         )
 
 
-def _peaks(arr: np.ndarray) -> np.ndarray:
-    """Largest deviation of each channel from its mean: the scale the centred solve sees."""
+def channel_ranges(arr: np.ndarray) -> np.ndarray:
+    """Each channel's range ``max - min``, shape (channels,) (zeros for no rows).
+
+    The scale the centred solve sees: every solve centres the lag vectors in two passes
+    (eqs. 24-25), so an offset costs no precision. Ranges of parts merge exactly (the
+    largest maximum, the smallest minimum), so a record split into pieces on a cluster
+    gives the same ranges as the whole.
+    """
     a = np.atleast_2d(arr.T).T if arr.ndim == 1 else arr
     if not a.shape[0]:
         return np.zeros(a.shape[1])
-    return np.abs(a - a.mean(axis=0)).max(axis=0)
+    return np.asarray(a.max(axis=0) - a.min(axis=0))
 
 
 def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
     """Refuse a whole record that double precision cannot solve (a :class:`DataError`).
 
-    A channel that varies, but never by more than :data:`MIN_MAGNITUDE` about its mean; with
-    ``scaling="none"``, channels whose largest deviations from their means differ by more
-    than :data:`MAX_SPREAD`. Deviations, not magnitudes: every solve centres the lag vectors
-    in two passes (eqs. 24-25), so an offset (a position logged as 1e12 counts) costs no
-    precision, and only the channels' variations must fit double precision together.
+    :func:`check_ranges` of the channels' :func:`channel_ranges`.
 
     Parameters
     ----------
@@ -237,16 +241,35 @@ def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
     scaling : {"none", "std"}
         The estimator's scaling; ``"std"`` scales each channel first and has no spread limit.
     """
-    peaks = np.concatenate([_peaks(u), _peaks(y)])
-    names = [f"u{i}" for i in range(_peaks(u).size)] + [f"y{i}" for i in range(_peaks(y).size)]
+    u_ranges, y_ranges = channel_ranges(u), channel_ranges(y)
+    check_ranges(np.concatenate([u_ranges, y_ranges]), u_ranges.size, scaling)
+
+
+def check_ranges(ranges: np.ndarray, n_inputs: int, scaling: str = "none") -> None:
+    """Refuse channel ranges that double precision cannot solve together.
+
+    A channel that varies, but over less than :data:`MIN_MAGNITUDE`; with
+    ``scaling="none"``, channels whose ranges differ by more than :data:`MAX_SPREAD`.
+    Ranges, not magnitudes: an offset (a position logged as 1e12 counts) costs no precision.
+
+    Parameters
+    ----------
+    ranges : ndarray, shape (channels,)
+        :func:`channel_ranges` of the inputs, then of the outputs.
+    n_inputs : int
+        How many of ``ranges`` are inputs.
+    scaling : {"none", "std"}
+        As for :func:`check_spread`.
+    """
+    peaks = np.asarray(ranges, dtype=float)
+    names = [f"u{i}" for i in range(n_inputs)] + [f"y{i}" for i in range(peaks.size - n_inputs)]
     nonzero = peaks > 0
     for p, n in zip(peaks, names, strict=True):
         if 0 < p < MIN_MAGNITUDE:
             raise DataError(
-                f"channel {n} never moves more than {p:.3g} from its mean: below "
-                f"{MIN_MAGNITUDE:.0e} this cannot be solved in double precision (products of "
-                "four samples underflow to 0). "
-                "Rescale the channel (other units, or divide by its RMS)."
+                f"channel {n} varies over a range of only {p:.3g}: below {MIN_MAGNITUDE:.0e} "
+                "this cannot be solved in double precision (products of four samples "
+                "underflow to 0). Rescale the channel (other units, or divide by its RMS)."
             )
     if scaling == "none" and nonzero.sum() > 1:
         big, small = peaks[nonzero].max(), peaks[nonzero].min()
@@ -254,9 +277,8 @@ def check_spread(u: np.ndarray, y: np.ndarray, scaling: str = "none") -> None:
             lo = names[int(np.flatnonzero(peaks == small)[0])]
             hi = names[int(np.flatnonzero(peaks == big)[0])]
             raise DataError(
-                f"channel {lo} (varying by up to {small:.3g} about its mean) and channel {hi} "
-                f"(up to {big:.3g}) differ in scale by {big / small:.3g} > {MAX_SPREAD:.3g}: "
-                "with scaling='none' this cannot be solved in double precision (the smaller "
-                "channel falls below the "
+                f"channel {lo} (range {small:.3g}) and channel {hi} (range {big:.3g}) differ "
+                f"in scale by {big / small:.3g} > {MAX_SPREAD:.3g}: with scaling='none' this "
+                "cannot be solved in double precision (the smaller channel falls below the "
                 "rounding of the larger). Pass scaling='std', or rescale the channels."
             )

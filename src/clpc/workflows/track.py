@@ -20,6 +20,7 @@ from clpc.core.checks import check_choice, check_int
 from clpc.core.compact import compact_repr
 from clpc.core.figure import MAX_POINTS
 from clpc.core.output_folder import OutputFolder
+from clpc.core.rules import RobustRule
 from clpc.data import DataError, IOData
 from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
 from clpc.io import iter_table_chunks, save_model
@@ -31,7 +32,17 @@ from clpc.workflows.common import AppraiserSettings, RecordSpec, SettingsError
 from clpc.workflows.save_check import save_refusal
 from clpc.workflows.track_advice import excitation_advice
 
-__all__ = ["Chunk", "ChunkFilter", "TrackResult", "TrackSettings", "count_data_lines", "track_file"]
+__all__ = [
+    "REPORT_SAMPLES",
+    "Appraised",
+    "Chunk",
+    "ChunkFilter",
+    "TrackResult",
+    "TrackSettings",
+    "count_data_lines",
+    "track_file",
+    "write_report",
+]
 
 #: column names and values of a block of rows (see :func:`clpc.io.iter_table_chunks`)
 Chunk = tuple[list[str], np.ndarray]
@@ -304,9 +315,9 @@ def _check_long_enough(run: _Run, settings: TrackSettings, trace_file: Path) -> 
         )
 
 
-def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
+def _report_data(done: Appraised, trace: Any) -> dict[str, Any]:
     """The record's last samples as :class:`IOData` for the report, and where they come from."""
-    rows = run.tail.rows
+    rows = done.tail
     n_in = trace.n_inputs
     if rows.shape[0] <= trace.structure.max_lag + 1:
         return {}
@@ -317,7 +328,7 @@ def _report_data(run: _Run, trace: Any) -> dict[str, Any]:
         input_names=trace.input_names,
         output_names=trace.output_names,
     )
-    n = run.appraiser.n_samples
+    n = done.n_samples
     where = f"all {n}" if rows.shape[0] >= n else f"the last {rows.shape[0]} of the {n}"
     note = (
         f"The model against {where} samples of the record (at the appraiser's sample time): "
@@ -389,26 +400,99 @@ def track_file(settings: TrackSettings, progress: ChunkFilter | None = None) -> 
     return dataclasses.replace(result, files=files, save_refused=refused)
 
 
+@dataclass(frozen=True)
+class Appraised:
+    """What the report of a tracked record is made of (bounded memory, every update counted).
+
+    Attributes
+    ----------
+    config : dict
+        The appraiser's settings (:meth:`clpc.CLPC.config`).
+    n_samples : int
+        Samples appraised (after decimation).
+    figures : Trace
+        The updates the figures show: every ``meta["thinned_stride"]``-th of
+        ``meta["updates_total"]`` (:class:`clpc.appraiser.tracefile.ThinnedTrace`).
+    whole : Trace or ScannedTrace
+        Every update: in memory with at least the arrays :func:`clpc.report.trace_summary`
+        reads, or scanned in parts (:class:`clpc.appraiser.scanned.ScannedTrace`).
+    recent : Trace or None
+        The last updates (the report's table).
+    tail : ndarray, shape (n, inputs + outputs)
+        The record's last :data:`REPORT_SAMPLES` samples at the appraiser's rate.
+    rule : RobustRule, optional
+        The appraiser's thresholds, for the report's window tests (default ``RobustRule()``).
+    n_raw : int
+        Rows read from the record (before any decimation; 0 when not counted).
+    data_dt : float
+        The record's sample time [s].
+    """
+
+    config: dict[str, Any]
+    n_samples: int
+    figures: Trace
+    whole: Trace | ScannedTrace
+    recent: Trace | None
+    tail: np.ndarray
+    rule: RobustRule | None = None
+    n_raw: int = 0
+    data_dt: float = 1.0
+
+
 def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> TrackResult:
     """The report of an appraised record, written into ``out``."""
     _check_long_enough(run, settings, trace_file)
-    trace = run.kept.trace()
-    whole = run.whole
+    done = Appraised(
+        run.appraiser.config(),
+        run.appraiser.n_samples,
+        run.kept.trace(),
+        run.whole,
+        run.whole.last,
+        run.tail.rows,
+        run.appraiser.rule,
+        run.n_raw,
+        run.data_dt,
+    )
+    return write_report(settings, done, trace_file, out)
+
+
+def write_report(
+    settings: TrackSettings, done: Appraised, trace_file: Path, out: Path
+) -> TrackResult:
+    """Summary, steady-state model, figures and ``report.html`` of a tracked record.
+
+    Parameters
+    ----------
+    settings : TrackSettings
+        The run's settings (record, appraiser, formats).
+    done : Appraised
+        What the appraisal produced.
+    trace_file : Path
+        The trace written (listed first among the files).
+    out : Path
+        Folder for the figures and the report.
+
+    Returns
+    -------
+    TrackResult
+    """
+    trace, whole = done.figures, done.whole
+    stride = int(trace.meta.get("thinned_stride", 1))
     file = settings.record.file
     report_settings = {
         "file": file,
-        "samples (after decimation)": run.appraiser.n_samples,
-        "updates": run.kept.seen,
-        "updates in figures": f"every {run.kept.stride}" if run.kept.stride > 1 else "all",
-        **run.appraiser.config(),
+        "samples (after decimation)": done.n_samples,
+        "updates": int(trace.meta.get("updates_total", len(whole))),
+        "updates in figures": f"every {stride}" if stride > 1 else "all",
+        **done.config,
     }
     summary = trace_summary(whole)
     record = settings.record
     command = {"file": file, "inputs": record.inputs, "outputs": record.outputs}
-    u_tail = run.tail.rows[:, : len(record.inputs)]
+    u_tail = done.tail[:, : len(record.inputs)]
     summary["advice"] = excitation_advice(whole, u_tail, settings.appraiser.window_size, command)
     model, source = steady_state(whole)
-    shown = _report_data(run, trace)
+    shown = _report_data(done, trace)
     report = write_track_report(
         out,
         trace,
@@ -416,8 +500,8 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
         settings=report_settings,
         summary=summary,
         steady=(model, source),
-        recent=run.whole.last,
-        rule=run.appraiser.rule,
+        recent=done.recent,
+        rule=done.rule,
         **shown,
     )
     fit = None
@@ -425,4 +509,4 @@ def _finish(settings: TrackSettings, run: _Run, trace_file: Path, out: Path) -> 
         data = shown["data"]
         fit = [None if f != f else float(f) for f in model_response(model, data.u, data.y)[2]]
     files = [trace_file, *report]
-    return TrackResult(summary, model, source, files, None, fit, trace, run.n_raw, run.data_dt)
+    return TrackResult(summary, model, source, files, None, fit, trace, done.n_raw, done.data_dt)

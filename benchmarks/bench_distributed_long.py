@@ -1,0 +1,257 @@
+"""One long record on a Dask cluster vs one process (issue 27 items 2 and 5).
+
+Data: the process of ``bench_clpc.py`` (white Gaussian input through the 2nd-order ARX system
+``A = 1 - 1.5 q^-1 + 0.7 q^-2``, ``B = 0.5 + 0.3 q^-1 + 0.1 q^-2``, equation noise 0.1, white
+measurement noise 0.02), ``--samples`` samples (default 1e7) written block by block to a
+``(T, 2)`` ``.npy`` file ``[u, y]`` in a temporary folder. Settings: ``order=2``,
+``W=201``, ``C=12`` (the paper's Table 1).
+
+Runs, all in one invocation:
+
+* ``single``: ``CLPC().run(u, y)`` in a fresh subprocess (the record loaded into memory first,
+  not timed; the trace kept), best of ``--repeat``;
+* ``run_long N``: :func:`clpc.distributed.run_long` on a ``LocalCluster`` of ``N`` worker
+  processes (one thread each): the workers read their memory-mapped slices of the ``.npy``
+  file; the trace's rows come back to this process (as ``run`` returns them);
+* ``track_long N``: :func:`clpc.distributed.track_long`: the workers write the trace as a
+  partitioned Parquet dataset; only the arrays of the summary, the updates of the report's
+  figures and the last updates come back (Dask's size estimates of the results).
+
+Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
+kernel is loaded in each worker), then timed. The ``run_long`` trace is compared with the
+single-process trace array by array (SHA-256 of every array: bit for bit).
+
+Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
+computing (summed over the task stream, by task: solve, fsm = the sequential chain, finish)
+and the scheduler overhead per piece = (N x wall - computing) / pieces (time a worker was
+not computing: scheduling, transfers, waiting for the chain); bytes per piece sent between
+workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
+(the pickled size of every result); peak RSS of each worker and of this process (added by
+the run). The load average is printed before and after: the machine may be shared.
+
+Usage::
+
+    python benchmarks/bench_distributed_long.py             # 1e7 samples, 1 and 2 workers
+    python benchmarks/bench_distributed_long.py --quick     # 1e6 samples (~1 min)
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import pickle
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+DEN = np.array([1.0, -1.5, 0.7])
+NUM = np.array([0.5, 0.3, 0.1])
+EQ_NOISE, MEAS_NOISE = 0.1, 0.02
+SEED = 20240607
+
+
+def generate_npy(path: Path, n: int, block: int = 1_000_000) -> None:
+    """``n`` samples of the benchmark process into a ``(n, 2)`` ``.npy`` file ``[u, y]``."""
+    rng = np.random.default_rng(SEED)
+    out = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(n, 2))
+    zi_u, zi_e = np.zeros(2), np.zeros(2)
+    for lo in range(0, n, block):
+        m = min(block, n - lo)
+        u = rng.standard_normal(m)
+        yu, zi_u = signal.lfilter(NUM, DEN, u, zi=zi_u)
+        ye, zi_e = signal.lfilter([1.0], DEN, EQ_NOISE * rng.standard_normal(m), zi=zi_e)
+        out[lo : lo + m, 0] = u
+        out[lo : lo + m, 1] = yu + ye + MEAS_NOISE * rng.standard_normal(m)
+    out.flush()
+    del out
+
+
+def digests(trace: Any) -> dict[str, str]:
+    """SHA-256 of every array of a trace (equal digests: bit-for-bit equal arrays)."""
+    arrays = {f: getattr(trace, f) for f in ("index", "time", "rows", "not_enough_data")}
+    arrays.update(trace.arrays)
+    return {
+        k: hashlib.sha256(np.ascontiguousarray(v).tobytes()).hexdigest() for k, v in arrays.items()
+    }
+
+
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def single(path: str, repeat: int) -> dict[str, Any]:
+    """The single-process run (in this process: call it in a fresh one)."""
+    from clpc import CLPC
+
+    data = np.load(path)
+    u, y = np.ascontiguousarray(data[:, 0]), np.ascontiguousarray(data[:, 1])
+    del data
+    CLPC().run(u[:20_000], y[:20_000])  # warm-up: the compiled kernel loaded
+    before = _peak_rss_mb()
+    best = (np.inf, np.inf)
+    trace = None
+    for _ in range(repeat):
+        trace = None
+        t0, c0 = time.perf_counter(), time.process_time()
+        trace = CLPC().run(u, y)
+        best = min(best, (time.perf_counter() - t0, time.process_time() - c0))
+    return {
+        "wall": best[0],
+        "cpu": best[1],
+        "updates": len(trace),
+        "digests": digests(trace),
+        "rss_added_mb": _peak_rss_mb() - before,
+    }
+
+
+def _task_seconds(stream: list[dict[str, Any]]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for task in stream:
+        name = str(task["key"]).split("-")[0].strip("('")
+        for ss in task["startstops"]:
+            if ss["action"] == "compute":
+                out[name] = out.get(name, 0.0) + ss["stop"] - ss["start"]
+    return out
+
+
+def _incoming_bytes(client: Any) -> int:
+    logs = client.run(
+        lambda dask_worker: sum(d["total"] for d in dask_worker.transfer_incoming_log)
+    )
+    return int(sum(logs.values()))
+
+
+def distributed_runs(
+    path: str, n_workers: int, reference: dict[str, Any], tmp: Path
+) -> list[dict[str, Any]]:
+    """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes."""
+    import distributed
+
+    from clpc import CLPC
+    from clpc.distributed import dask_client, run_long, track_long
+    from clpc.distributed.sources import NpySource
+
+    source = NpySource(path, (0,), (1,))
+    warm = tmp / "warm.npy"
+    np.save(warm, np.load(path, mmap_mode="r")[:50_000])
+    rows = []
+    with dask_client(workers=n_workers) as client:
+        for _ in range(2):  # every worker loads the kernel
+            run_long(CLPC(), NpySource(str(warm), (0,), (1,)), client=client, piece_samples=10_000)
+        for mode in ("run_long", "track_long"):
+            base = _incoming_bytes(client)
+            rss0 = _peak_rss_mb()
+            with distributed.get_task_stream(client) as ts:
+                t0 = time.perf_counter()
+                if mode == "run_long":
+                    trace = run_long(CLPC(), source, client=client)
+                    wall = time.perf_counter() - t0
+                    updates = len(trace)
+                else:
+                    result = track_long(CLPC(), source, tmp / f"out{n_workers}", client=client)
+                    wall = time.perf_counter() - t0
+                    updates = result.summary["updates"]
+            equal, to_client = None, None
+            if mode == "run_long":  # checked after the timing
+                equal = digests(trace) == reference["digests"]
+                # what came back: the trace rows (pickled sizes of the arrays)
+                to_client = sum(len(pickle.dumps(a, protocol=5)) for a in trace.arrays.values())
+                del trace
+            seconds = _task_seconds(ts.data)
+            pieces = sum(1 for t in ts.data if str(t["key"]).startswith("solve_piece"))
+            computing = sum(seconds.values())
+            if to_client is None:  # summary, figures, last rows: Dask's sizes of the results
+                to_client = sum(
+                    t["nbytes"] for t in ts.data if str(t["key"]).startswith("write_piece")
+                )
+            worker_rss = client.run(
+                lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            )
+            rows.append(
+                {
+                    "mode": mode,
+                    "workers": n_workers,
+                    "wall": wall,
+                    "updates": updates,
+                    "equal": equal,
+                    "pieces": pieces,
+                    "seconds": seconds,
+                    "overhead_per_piece": (n_workers * wall - computing) / pieces,
+                    "between_workers_per_piece": (_incoming_bytes(client) - base) / pieces,
+                    "to_client_per_piece": to_client / pieces,
+                    "worker_peak_rss_mb": max(worker_rss.values()),
+                    "client_rss_added_mb": _peak_rss_mb() - rss0,
+                }
+            )
+    return rows
+
+
+def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
+    secs, wall = row["seconds"], row["wall"]
+    chain = secs.get("fsm_piece", 0.0) + secs.get("end_state", 0.0)
+    finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
+    print(
+        f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
+        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x  "
+        f"equal to single: {row['equal']}"
+    )
+    print(
+        f"    {row['pieces']} pieces; computing {sum(secs.values()):.2f} s (solve "
+        f"{secs.get('solve_piece', 0.0):.2f}, sequential FSM chain {chain:.2f} = "
+        f"{100 * chain / wall:.1f} % of the wall time, finish {finish:.2f})"
+        f"; scheduler overhead per piece {1e3 * row['overhead_per_piece']:.1f} ms"
+    )
+    print(
+        f"    bytes per piece: between workers {row['between_workers_per_piece'] / 1e3:.1f} kB, "
+        f"to the client {row['to_client_per_piece'] / 1e6:.2f} MB; peak RSS: worker "
+        f"{row['worker_peak_rss_mb']:.0f} MB, client added {row['client_rss_added_mb']:.0f} MB"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=float, default=1e7)
+    parser.add_argument("--quick", action="store_true", help="1e6 samples")
+    parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--repeat", type=int, default=1, help="single-process repetitions")
+    parser.add_argument("--single-worker", nargs=2, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.single_worker:
+        print(json.dumps(single(args.single_worker[0], int(args.single_worker[1]))))
+        return
+    n = int(1e6 if args.quick else args.samples)
+    print(f"load average before: {os.getloadavg()}; cores: {os.cpu_count()}")
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = Path(tmpdir)
+        path = tmp / "record.npy"
+        t0 = time.perf_counter()
+        generate_npy(path, n)
+        took = time.perf_counter() - t0
+        print(f"record: {n:.3g} samples, {path.stat().st_size / 1e6:.0f} MB ({took:.1f} s)")
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+        cmd = [sys.executable, __file__, "--single-worker", str(path), str(args.repeat)]
+        ref = json.loads(
+            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
+        )
+        print(
+            f"\nsingle      wall {ref['wall']:7.2f} s  cpu {ref['cpu']:7.2f} s  "
+            f"{n / ref['wall']:10.3g} samples/s  {ref['updates']} updates  "
+            f"peak RSS added {ref['rss_added_mb']:.0f} MB"
+        )
+        for w in args.workers:
+            for row in distributed_runs(str(path), w, ref, tmp):
+                _show(row, n, ref)
+    print(f"\nload average after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,265 @@
+"""A long record's trace written by the workers, and its summary from every update.
+
+:func:`track_long` appraises a ``.npy`` or Parquet record piece by piece on a Dask cluster
+(:mod:`clpc.distributed.long_record`). Each worker writes its piece's rows as one file of a
+partitioned Parquet dataset ``OUT/trace/part-NNNNNN.parquet`` (the columns of
+:func:`clpc.appraiser.tracefile.trace_columns`, in time order by file name; readable with
+``pandas.read_parquet("OUT/trace")`` or ``pyarrow.dataset``) and sends back only the
+per-update arrays the summary reads (about a third of a row). The summary
+(:func:`clpc.report.trace_summary`: counts, convergence, findings, the steady-state model)
+is computed from all updates and written to ``OUT/summary.json``.
+
+The dataset is written into a hidden folder and renamed to ``OUT/trace`` when every piece
+is complete: a failed or killed run leaves the previous dataset (or none), never a part.
+Every worker must see ``OUT`` at the same path (one machine, or a shared file system).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import shutil
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from clpc.appraiser import CLPC
+from clpc.appraiser.decimation import Decimator
+from clpc.core.atomic import write_file
+from clpc.data import DataError
+from clpc.distributed.cluster import dask_client
+from clpc.distributed.long_record import check_peaks, gather, plan_record
+from clpc.distributed.piece_tasks import RecordPlan, take_rows, write_piece
+from clpc.distributed.pieces import warmup
+from clpc.distributed.schedule import run_pieces
+from clpc.distributed.sources import NpySource, ParquetSource, open_source
+from clpc.model import LinearModel
+from clpc.report import steady_state, trace_summary
+from clpc.workflows import TrackSettings
+from clpc.workflows.common import SettingsError
+from clpc.workflows.track import REPORT_SAMPLES, Appraised, TrackResult, write_report
+
+__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
+
+#: the last updates the report's table shows (as ``clpc track``'s)
+RECENT = 20
+#: the per-update arrays that counts, convergence, findings and the steady-state model read
+#: (the same as ``clpc track`` keeps for its summary)
+SUMMARY_KEYS = (
+    "theta",
+    "D",
+    "c",
+    "accepted",
+    "has_model",
+    "trusted",
+    "determined",
+    "degenerate",
+    "excited",
+    "n_input_relations",
+    "stable",
+)
+
+
+@dataclass(frozen=True)
+class LongTrack:
+    """The outcome of :func:`track_long`.
+
+    Attributes
+    ----------
+    summary : dict
+        :func:`clpc.report.trace_summary` of every update.
+    model : LinearModel or None
+        The steady-state model (``None``: no update was accepted).
+    model_source : str
+        Where ``model`` comes from (see :func:`clpc.report.steady_state`).
+    dataset : Path
+        The folder of the trace's Parquet parts.
+    parts : int
+        Pieces (files of the dataset).
+    appraised : Appraised
+        What a report is made of (:func:`clpc.workflows.track.write_report`).
+    """
+
+    summary: dict[str, Any]
+    model: LinearModel | None
+    model_source: str
+    dataset: Path
+    parts: int
+    appraised: Appraised
+
+
+def track_long(
+    appraiser: CLPC,
+    source: NpySource | ParquetSource,
+    out: str | os.PathLike[str],
+    *,
+    dt: float | None = None,
+    client: Any = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    piece_samples: int | None = None,
+    figure_updates: int = 20_000,
+    window_levels: bool = True,
+) -> LongTrack:
+    """Appraise a record file on a Dask cluster; the workers write the trace as a dataset.
+
+    Parameters
+    ----------
+    appraiser : CLPC
+        The appraiser's settings (it is reset).
+    source : NpySource or ParquetSource
+        The record (:func:`clpc.distributed.open_source`).
+    out : path
+        Folder for ``trace/`` and ``summary.json`` (created).
+    dt : float, optional
+        The data's sample time [s] (default the appraiser's ``dt``).
+    client, scheduler, workers
+        Where to run (:func:`clpc.distributed.dask_client`).
+    piece_samples : int, optional
+        Decimated samples per piece (default
+        :func:`clpc.distributed.long_record.default_piece_samples`).
+    figure_updates : int
+        The report's figures show at most about twice this many updates (as ``clpc track``).
+    window_levels : bool
+        Keep the windows' levels (``meta["window_level"]``, as :meth:`clpc.CLPC.run`) for
+        the summary's findings; ``False``: without them, as ``clpc track`` (which reads a
+        record in chunks) summarises.
+
+    Returns
+    -------
+    LongTrack
+
+    Raises
+    ------
+    clpc.DataError
+        A record without a single update, a sample that is not finite, channels of
+        hopeless scales.
+    """
+    appraiser.reset()
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    channels = (len(source.inputs), len(source.outputs))
+    plan = plan_record(appraiser, channels, source.length(), dt, source.names())
+    total = plan.layout.updates(plan.n_raw)
+    if total == 0:
+        raise DataError(
+            f"{source.path}: {plan.n_raw} sample(s) give no cluster update with "
+            f"window_size={appraiser.window_size}, cluster_size={appraiser.cluster_size}; use "
+            "a longer record (or track it on one machine)."
+        )
+    staging = folder / f".trace-{uuid.uuid4().hex}"
+    stride = thinning_stride(total, figure_updates)
+    finish = (write_piece, (str(staging.resolve()), SUMMARY_KEYS, (stride, RECENT)))
+    try:
+        with dask_client(client, scheduler, workers) as dask:
+            parts, peaks = run_pieces(dask, plan, source, piece_samples, finish)
+            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False).result()
+        check_peaks(appraiser, peaks, channels[0])
+        whole = gather([p.summary for p in parts])
+        if not window_levels:
+            meta = {k: v for k, v in whole.meta.items() if k != "window_level"}
+            whole = dataclasses.replace(whole, meta=meta)
+        summary = trace_summary(whole)
+        _replace(staging, folder / "trace")
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    write_file(folder / "summary.json", json.dumps(summary, indent=1))
+    model, model_source = steady_state(whole)
+    figures = gather([p.figures for p in parts])
+    figures = dataclasses.replace(
+        figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
+    )
+    last = gather([p.last for p in parts[-2:]])
+    recent = take_rows(last, np.arange(max(len(last) - RECENT, 0), len(last)))
+    n_kept = plan.layout.kept(plan.n_raw)
+    done = Appraised(appraiser.config(), n_kept, figures, whole, recent, tail)
+    return LongTrack(summary, model, model_source, folder / "trace", len(parts), done)
+
+
+def thinning_stride(updates: int, figure_updates: int) -> int:
+    """The stride :class:`clpc.appraiser.thinned.ThinnedTrace` ends with for ``updates``.
+
+    The smallest power of two ``s`` with ``ceil(updates / s) <= 2 * figure_updates``.
+    """
+    stride = 1
+    while -(-updates // stride) > 2 * figure_updates:
+        stride *= 2
+    return stride
+
+
+def tail_samples(source: NpySource | ParquetSource, plan: RecordPlan, n: int) -> np.ndarray:
+    """The record's last ``n`` samples at the appraiser's rate, ``[inputs | outputs]``.
+
+    Read on a worker; with decimation the filter starts :func:`.pieces.warmup` samples
+    before (the values agree with ``clpc track``'s to rounding).
+    """
+    lay = plan.layout
+    first = max(0, lay.kept(plan.n_raw) - n)
+    lo = max(0, first * lay.factor - warmup(lay.factor))
+    raw = source.read(lo, plan.n_raw)
+    kept = Decimator(lay.factor)(raw) if lay.factor > 1 else raw
+    return np.array(kept[first - lo // lay.factor :], dtype=np.float64)
+
+
+def track_settings(
+    settings: TrackSettings,
+    *,
+    client: Any = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+) -> tuple[TrackResult, LongTrack]:
+    """``clpc track`` with ``--workers``/``--scheduler``: :func:`track_long`, then the report.
+
+    The record, its columns, ``--dt``, the appraiser's settings and ``--out`` are those of
+    the command; ``OUT`` gets ``trace/`` (the dataset), ``summary.json``, the figures and
+    ``report.html`` of :func:`clpc.workflows.track.write_report`.
+
+    Raises
+    ------
+    SettingsError
+        A time column (give ``--dt``), or a file that is not ``.npy`` or Parquet.
+    """
+    record = settings.record
+    if record.time_col is not None:
+        raise SettingsError(
+            "a record split over workers needs a uniform sample time given with --dt "
+            "(a time column is checked chunk by chunk on one machine: drop --workers/"
+            "--scheduler, or give --dt instead of --time)."
+        )
+    try:
+        keys = record.columns()  # digits as 0-based positions, as clpc track reads them
+        n_in, n_out = len(record.inputs), len(record.outputs)
+        source = open_source(record.file, tuple(keys[:n_in]), tuple(keys[n_in : n_in + n_out]))
+    except DataError as exc:
+        raise SettingsError(str(exc)) from None
+    done = track_long(
+        settings.appraiser.build(record.dt),
+        source,
+        settings.out_dir,
+        dt=record.dt,
+        client=client,
+        scheduler=scheduler,
+        workers=workers,
+        figure_updates=settings.figure_updates,
+        window_levels=False,
+    )
+    out = Path(settings.out_dir)
+    result = write_report(settings, done.appraised, done.dataset, out)
+    write_file(out / "summary.json", json.dumps(result.summary, indent=1))
+    files = [*result.files, out / "summary.json"]
+    return dataclasses.replace(result, files=files), done
+
+
+def _replace(new: Path, target: Path) -> None:
+    """Rename the folder ``new`` to ``target``, removing a previous ``target`` folder."""
+    if target.is_symlink() or (target.exists() and not target.is_dir()):
+        raise DataError(f"{target} exists and is not a trace folder; remove it or pick --out.")
+    old = target.with_name(f".{target.name}-old-{uuid.uuid4().hex}")
+    if target.exists():
+        target.rename(old)
+    new.rename(target)
+    shutil.rmtree(old, ignore_errors=True)
