@@ -12,7 +12,6 @@ convergence point go to a scratch file for the variations' second pass.
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -33,18 +32,6 @@ from clpc.model.trace_findings import Findings
 __all__ = ["RECENT", "ScannedTrace"]
 
 RECENT = 20  #: updates kept for the report's table of the last updates
-
-
-def _tail(trace: Trace, n: int) -> Trace:
-    """The last ``n`` updates of ``trace`` (``n >= 1``)."""
-    return dataclasses.replace(
-        trace,
-        index=trace.index[-n:],
-        time=trace.time[-n:],
-        rows=trace.rows[-n:],
-        not_enough_data=trace.not_enough_data[-n:],
-        arrays={k: v[-n:] for k, v in trace.arrays.items()},
-    )
 
 
 class ScannedTrace:
@@ -102,11 +89,11 @@ class ScannedTrace:
         c["lacking"] += int((a["n_input_relations"] > 0).any(axis=1).sum())
         self.D_last = a["D"][-1].copy()
         if self._labels is None:
-            self._labels = _tail(part, 1)
+            self._labels = part.take(slice(-1, None))
         recent = (
             part if self.last is None or len(part) >= RECENT else Trace.concat([self.last, part])
         )
-        self.last = recent if len(recent) <= RECENT else _tail(recent, RECENT)
+        self.last = recent if len(recent) <= RECENT else recent.take(slice(-RECENT, None))
         self._conv = None
 
     def __len__(self) -> int:

@@ -39,7 +39,7 @@ class ThinnedTrace:
         self.seen += n
         keep = np.flatnonzero(numbers % self.stride == 0)
         if keep.size:
-            self._parts.append(_take(part, keep))
+            self._parts.append(part.take(keep))
             self._held += keep.size
         while self._held > 2 * self.max_updates:
             self._thin()
@@ -48,7 +48,7 @@ class ThinnedTrace:
         merged = Trace.concat(self._parts)
         # kept updates are numbered 0, s, 2s, ...: keep the multiples of 2s
         self.stride *= 2
-        merged = _take(merged, np.arange(0, len(merged), 2))
+        merged = merged.take(np.arange(0, len(merged), 2))
         self._parts = [merged]
         self._held = len(merged)
 
@@ -57,14 +57,3 @@ class ThinnedTrace:
         merged = Trace.concat(self._parts)
         meta = dict(merged.meta, thinned_stride=self.stride, updates_total=self.seen)
         return replace(merged, meta=meta)
-
-
-def _take(trace: Trace, rows: np.ndarray) -> Trace:
-    return replace(
-        trace,
-        index=trace.index[rows],
-        time=trace.time[rows],
-        rows=trace.rows[rows],
-        not_enough_data=trace.not_enough_data[rows],
-        arrays={k: v[rows] for k, v in trace.arrays.items()},
-    )

@@ -6,7 +6,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -263,6 +263,33 @@ class Trace:
             for key in SCALAR_KEYS:
                 cols[pre + key] = self.arrays[key][:, e]
         return pd.DataFrame(cols)
+
+    def take(self, rows: Any) -> Trace:
+        """The updates ``rows`` as a trace of their own.
+
+        Parameters
+        ----------
+        rows : ndarray of int or bool, or slice
+            Which updates, as for indexing ``trace.index``.
+
+        Returns
+        -------
+        Trace
+            ``meta["window_level"]`` (one row per update) is taken along when it matches.
+        """
+        meta = dict(self.meta)
+        levels = meta.get("window_level")
+        if levels is not None and np.shape(levels)[0] == len(self):
+            meta["window_level"] = np.asarray(levels)[rows]
+        return replace(
+            self,
+            index=self.index[rows],
+            time=self.time[rows],
+            rows=self.rows[rows],
+            not_enough_data=self.not_enough_data[rows],
+            arrays={k: v[rows] for k, v in self.arrays.items()},
+            meta=meta,
+        )
 
     def held(self, n_samples: int) -> np.ndarray:
         """Held output parameters at every sample ``k = 0 .. n_samples - 1``.

@@ -33,7 +33,7 @@ from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
 from clpc.distributed.long_record import check_peaks, gather, plan_record
-from clpc.distributed.piece_tasks import RecordPlan, take_rows, write_piece
+from clpc.distributed.piece_tasks import RecordPlan, write_piece
 from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
 from clpc.distributed.sources import NpySource, ParquetSource, open_source
@@ -174,7 +174,7 @@ def track_long(
         figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
     )
     last = gather([p.last for p in parts[-2:]])
-    recent = take_rows(last, np.arange(max(len(last) - RECENT, 0), len(last)))
+    recent = last.take(np.arange(max(len(last) - RECENT, 0), len(last)))
     n_kept = plan.layout.kept(plan.n_raw)
     done = Appraised(appraiser.config(), n_kept, figures, whole, recent, tail)
     return LongTrack(summary, model, model_source, folder / "trace", len(parts), done)

@@ -42,7 +42,6 @@ __all__ = [
     "finish_piece",
     "fsm_piece",
     "solve_piece",
-    "take_rows",
     "trace_nbytes",
     "write_piece",
 ]
@@ -258,22 +257,6 @@ def write_piece(
     arrays = {k: v for k, v in trace.arrays.items() if k in keep}
     return WrittenPiece(
         dataclasses.replace(trace, arrays=arrays),
-        take_rows(trace, np.flatnonzero(numbers % stride == 0)),
-        take_rows(trace, np.arange(max(len(trace) - last, 0), len(trace))),
-    )
-
-
-def take_rows(trace: Trace, rows: np.ndarray) -> Trace:
-    """The updates ``rows`` of a trace (``meta["window_level"]`` taken along)."""
-    meta = dict(trace.meta)
-    if "window_level" in meta:
-        meta["window_level"] = meta["window_level"][rows]
-    return dataclasses.replace(
-        trace,
-        index=trace.index[rows],
-        time=trace.time[rows],
-        rows=trace.rows[rows],
-        not_enough_data=trace.not_enough_data[rows],
-        arrays={k: v[rows] for k, v in trace.arrays.items()},
-        meta=meta,
+        trace.take(np.flatnonzero(numbers % stride == 0)),
+        trace.take(np.arange(max(len(trace) - last, 0), len(trace))),
     )
