@@ -41,7 +41,7 @@ from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
 from clpc.workflows import TrackSettings
 from clpc.workflows.common import SettingsError
-from clpc.workflows.track import REPORT_SAMPLES, Appraised, TrackResult, write_report
+from clpc.workflows.track_report import REPORT_SAMPLES, Appraised, TrackResult, write_report
 
 __all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
 
