@@ -128,6 +128,11 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
         return int(self.theta_matrix.shape[0])
 
     @property
+    def warmup(self) -> int:
+        """Samples before the first full prediction: the largest lag (``structure.max_lag``)."""
+        return int(self.structure.max_lag)
+
+    @property
     def is_siso(self) -> bool:
         """One input and one output."""
         return self.n_outputs == 1 and self.n_inputs == 1

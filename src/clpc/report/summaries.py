@@ -65,13 +65,14 @@ def verdict_text(model: LinearModel, output: int = 0) -> str | None:
 
 
 def model_response(
-    model: LinearModel, u: Any, y: Any, k: int | None = None
+    model: Any, u: Any, y: Any, k: int | None = None
 ) -> tuple[np.ndarray, int, np.ndarray]:
     """Simulated (``k=None``) or ``k``-step-predicted output of a model on measured data.
 
     Parameters
     ----------
-    model : LinearModel
+    model : LinearModel or MultiModel
+        Anything with ``warmup``, ``simulate(u, y_init=, u_init=)`` and ``predict(u, y, k)``.
     u : array_like, shape (T, n_inputs)
         Measured inputs.
     y : array_like, shape (T, n_outputs)
@@ -82,26 +83,27 @@ def model_response(
     Returns
     -------
     y_hat : ndarray, shape (T, n_outputs)
-        Model output. The first ``max_lag`` samples have no complete past and are copied
-        from ``y``; the free-run simulation starts from those measured samples (initial
-        conditions) and then uses the input alone.
+        Model output. The first ``model.warmup`` samples have no complete past and are
+        copied from ``y``; the free-run simulation starts from those measured samples
+        (initial conditions) and then uses the input alone.
     start : int
-        First compared sample (``max_lag``).
+        First compared sample (``warmup``, plus ``k - 1`` for a prediction).
     fit : ndarray, shape (n_outputs,)
         Fit % over samples ``start:`` (NaN when the simulation diverges).
     """
     u2 = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
     y2 = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
-    start = model.structure.max_lag
+    start = model.warmup
     if y2.shape[0] <= start + 1:
         raise ValueError(
-            f"comparing needs more than {start + 1} samples (the model's max lag is {start}); "
+            f"comparing needs more than {start + 1} samples (the model's warm-up is {start}); "
             f"got {y2.shape[0]}."
         )
     if k is None:
         y_hat = y2.copy()
         with np.errstate(over="ignore", invalid="ignore"):
-            y_hat[start:] = model.simulate(u2[start:], y_init=y2[:start], u_init=u2[:start])
+            free = model.simulate(u2[start:], y_init=y2[:start], u_init=u2[:start])
+        y_hat[start:] = np.asarray(free).reshape(-1, y2.shape[1])
     else:
         y_hat = np.asarray(model.predict(u2, y2, k=k)).reshape(y2.shape)
         start += k - 1  # only true k-step predictions are scored (as clpc.kstep_fit)

@@ -16,8 +16,7 @@ from clpc.io import load_model, read_table, write_table
 from clpc.io.model_files import load_any_model
 from clpc.multimodel import MultiModel
 from clpc.report import model_response
-from clpc.workflows.common import RecordSpec, column_keys, model_columns
-from clpc.workflows.compare_multimodel import compare_multimodel
+from clpc.workflows.common import RecordSpec, SettingsError, column_keys, model_columns
 
 __all__ = ["CompareResult", "CompareSettings", "SimulateResult", "compare_file", "simulate_file"]
 
@@ -200,18 +199,19 @@ def compare_file(settings: CompareSettings) -> CompareResult:
     """
     model = load_any_model(settings.model_file)
     if isinstance(model, MultiModel):
-        return _compare_multimodel(model, settings)
-    ins = model_columns(model, settings.record.inputs, "input")
-    outs = model_columns(model, settings.record.outputs, "output")
+        ins, outs = _multimodel_columns(model, settings.record)
+    else:
+        ins = model_columns(model, settings.record.inputs, "input")
+        outs = model_columns(model, settings.record.outputs, "output")
     record = dataclasses.replace(settings.record, inputs=tuple(ins), outputs=tuple(outs))
     data = record.load()
     _check_sample_time(model.dt, data.dt, record)
-    first = model.structure.max_lag + (settings.k or 1) - 1  # first sample scored
+    first = model.warmup + (settings.k or 1) - 1  # first sample scored
     if settings.k is not None and data.n_samples <= first + 1:
         raise DataError(
             f"--k {settings.k}: a {settings.k}-step prediction is scored from sample {first} "
-            f"on (max lag {model.structure.max_lag} + k - 1), but {record.file} has "
-            f"{data.n_samples} samples; use a k below {data.n_samples - model.structure.max_lag}."
+            f"on (max lag {model.warmup} + k - 1), but {record.file} has "
+            f"{data.n_samples} samples; use a k below {data.n_samples - model.warmup}."
         )
     with np.errstate(over="ignore", invalid="ignore"):  # a diverging fit is reported as NaN
         y_hat, start, fit = model_response(model, data.u, data.y, settings.k)
@@ -224,18 +224,21 @@ def compare_file(settings: CompareSettings) -> CompareResult:
     return CompareResult(record.file, what, start, data.n_samples, fits, settings.plot or None)
 
 
-def _compare_multimodel(model: MultiModel, settings: CompareSettings) -> CompareResult:
-    comp = compare_multimodel(model, settings.record, settings.k)
-    _check_sample_time(model.dt, comp.dt, settings.record)
-    what = "simulation" if settings.k is None else f"{settings.k}-step prediction"
-    outs = list(settings.record.outputs)
-    if settings.plot:
-        from clpc.plotting import plot_compare
+def _multimodel_columns(model: MultiModel, record: RecordSpec) -> tuple[list[str], list[str]]:
+    """A multi-model file names no channels: its columns must be given, as many as it has.
 
-        plot_compare(comp.time, comp.y, comp.y_hat, comp.fit, settings.plot, names=outs, label=what)
-    fits = dict(zip(outs, jsonable(comp.fit), strict=True))
-    n = comp.y.shape[0]
-    return CompareResult(settings.record.file, what, comp.start, n, fits, settings.plot or None)
+    Raises
+    ------
+    SettingsError
+        Not ``model.n_inputs`` input columns and one output column.
+    """
+    if len(record.inputs) != model.n_inputs or len(record.outputs) != 1:
+        raise SettingsError(
+            f"a multi-model file names no columns: give its {model.n_inputs} input column(s) "
+            f"with -u and its one output column with -y (given: inputs {list(record.inputs)}, "
+            f"outputs {list(record.outputs)})."
+        )
+    return list(record.inputs), list(record.outputs)
 
 
 def _check_sample_time(model_dt: float, data_dt: float, record: RecordSpec) -> None:
