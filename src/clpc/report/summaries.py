@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from clpc.analysis.metrics import fit_percent
+from clpc.appraiser.convergence import Convergence
 from clpc.appraiser.scanned import ScannedTrace
 from clpc.appraiser.trace import SCALAR_KEYS, Trace
 from clpc.core.jsonable import jsonable
@@ -266,7 +267,9 @@ def update_records(trace: Trace) -> list[dict[str, Any]]:
     return records
 
 
-def steady_state(trace: Trace | ScannedTrace) -> tuple[LinearModel | None, str]:
+def steady_state(
+    trace: Trace | ScannedTrace, convergence: Convergence | None = None
+) -> tuple[LinearModel | None, str]:
     """The model a trace settles on, and where it comes from.
 
     Parameters
@@ -274,6 +277,8 @@ def steady_state(trace: Trace | ScannedTrace) -> tuple[LinearModel | None, str]:
     trace : Trace or ScannedTrace
         A CLPC trace (:class:`clpc.Trace`), or one read in parts; convergence is judged
         with the default tolerances of :meth:`Trace.convergence`.
+    convergence : Convergence, optional
+        That convergence when already known (it is not searched again).
 
     Returns
     -------
@@ -283,7 +288,7 @@ def steady_state(trace: Trace | ScannedTrace) -> tuple[LinearModel | None, str]:
     source : str
         ``"steady state"``, ``"last accepted update (not converged)"`` or ``"none"``.
     """
-    conv = trace.convergence()
+    conv = trace.convergence() if convergence is None else convergence
     if conv.converged:
         return trace.steady_state_model(conv), "steady state"
     try:
@@ -314,7 +319,7 @@ def trace_summary(trace: Trace | ScannedTrace) -> dict[str, Any]:
     """
     scan = trace if isinstance(trace, ScannedTrace) else ScannedTrace.of(trace)
     conv = scan.convergence()
-    model, source = steady_state(scan if isinstance(trace, ScannedTrace) else trace)
+    model, source = steady_state(trace, conv)
     counts, n = scan.counts, len(scan)
     return {
         "updates": n,
