@@ -191,10 +191,40 @@ def _factor(root: complex) -> np.ndarray:
     return np.array([1.0, -root.real])
 
 
+def _roots(p: np.ndarray) -> np.ndarray:
+    """Roots of ``p`` (descending powers, as :func:`numpy.roots`), cheap at low degree.
+
+    A fit calls this on every output's polynomials, so degrees 1 and 2 are solved in closed
+    form (the quadratic without cancellation) instead of :func:`numpy.roots`' companion
+    eigenvalues; higher degrees go to :func:`numpy.linalg.eigvals` of the companion matrix.
+    Leading zeros are dropped; trailing zeros are roots at 0.
+    """
+    nz = np.flatnonzero(p)
+    if nz.size == 0:
+        return np.empty(0, dtype=complex)
+    at_zero = p.size - 1 - int(nz[-1])
+    p = p[int(nz[0]) : int(nz[-1]) + 1]
+    deg = p.size - 1
+    if deg == 0:
+        found = np.empty(0, dtype=complex)
+    elif deg == 1:
+        found = np.array([complex(-p[1] / p[0])])
+    elif deg == 2:
+        b, c = p[1] / p[0], p[2] / p[0]
+        disc = complex(b * b - 4.0 * c) ** 0.5
+        big = -0.5 * (b + disc) if b >= 0 else -0.5 * (b - disc)  # no cancellation
+        found = np.array([big, c / big if big else 0j])
+    else:
+        companion = np.diag(np.ones(deg - 1), -1)
+        companion[0, :] = -p[1:] / p[0]
+        found = np.linalg.eigvals(companion).astype(complex)
+    return np.concatenate([found, np.zeros(at_zero, dtype=complex)])
+
+
 def _pairs(den: np.ndarray, nums: list[np.ndarray], tol: float) -> list[complex]:
     """Poles of ``den`` within ``tol`` of a zero of every nonzero numerator (one per conj pair)."""
-    poles = np.roots(den)
-    zero_sets = [np.roots(np.trim_zeros(b, "f")) for b in nums if np.any(b != 0)]
+    poles = _roots(den)
+    zero_sets = [_roots(b) for b in nums if np.any(b != 0)]
     if not zero_sets or any(z.size == 0 for z in zero_sets):
         return []
     found: list[complex] = []
