@@ -133,11 +133,13 @@ def miso_regressor(
     start, na1, nb1 = structure.max_lag, structure.na + 1, structure.nb + 1
     if out is None:
         out = np.empty((y.shape[0] - start, na1 + u.shape[1] * nb1))
-    out[:, :na1] = lagged(y, structure.na, 0, start)
+    end = y.shape[0]
+    for j in range(na1):  # column by column: cheaper than a strided view at small T
+        out[:, j] = y[start - j : end - j]
     for i in range(u.shape[1]):
-        out[:, na1 + i * nb1 : na1 + (i + 1) * nb1] = lagged(
-            u[:, i], structure.nb, structure.nk, start
-        )
+        for j in range(nb1):
+            lag = structure.nk + j
+            out[:, na1 + i * nb1 + j] = u[start - lag : end - lag, i]
     return out
 
 
