@@ -336,3 +336,25 @@ def test_a_choice_whose_refit_is_unstable_gives_way():
     assert "unstable" in rows[1]["note"] and "unstable" in rows[0]["note"]
     stable = clpc.as_iodata(u, signal.lfilter([1.0], [1.0, -0.5], u))
     assert comparison.stable_refits(stable, rows, [1], None) == [1]
+
+
+def test_the_screen_memory_does_not_grow_with_the_number_of_structures(monkeypatch):
+    """The screened simulations run a block of structures at a time (memory O(T), not k T)."""
+    import tracemalloc
+
+    import clpc.lpc.screen as screen_module
+
+    u, y = _record(0, "output", n=40_000)
+    folds = comparison.rolling_origin(clpc.IOData(u, y, dt=0.1), 0.2)
+    few = [clpc.Structure(na, 2, 0) for na in range(1, 4)]
+    many = [clpc.Structure(na, nb, nk) for na in range(1, 4) for nb in range(6) for nk in range(4)]
+    monkeypatch.setattr(screen_module, "DRIVE_BYTES", 2**20)
+    peaks = []
+    for structures in (few, many):
+        tracemalloc.start()
+        windows = screen(folds, structures, "siso").windows
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        assert np.isfinite(windows).all()
+    # 72 structures against 3: one drive column per structure would be 24x the drive memory
+    assert peaks[1] < 1.5 * peaks[0] + 2 * 2**20, peaks

@@ -34,6 +34,9 @@ __all__ = ["PARSIMONY", "Screen", "screen"]
 
 #: Points of mean held-out free-run fit a structure with fewer parameters may give away.
 PARSIMONY = 1.0
+#: Memory for the input part of the screened simulations, simulated a block of structures
+#: at a time [bytes].
+DRIVE_BYTES = 32 * 2**20
 
 
 @dataclass(frozen=True)
@@ -200,15 +203,22 @@ class _LagSet:
         from scipy import signal  # imported when used: scipy.signal costs ~0.8 s
 
         mat = self._matrix(y, u)
-        drive = mat[:, self.na : -1] @ coef[:, self.na :].T + k  # (rows, n_structures)
+        inputs = mat[:, self.na : -1]
         past = y[self.start - 1 :: -1][: self.na]  # y(start-1), y(start-2), ...
         target = y[self.start :]
         out = np.empty(coef.shape[0])
+        # the input part of every structure's simulation, a block of structures at a time:
+        # memory O(rows), not O(rows * n_structures)
+        block = max(1, DRIVE_BYTES // max(1, 8 * target.size))
         with np.errstate(all="ignore"):
-            for s, na in enumerate(self.orders):
-                den = np.concatenate([[1.0], -coef[s, :na]])
-                # lfilter's transposed direct-form state for the measured past outputs
-                zi = np.array([den[m + 1 :] @ past[: na - m] for m in range(na)])
-                sim = signal.lfilter([1.0], den, drive[:, s], zi=-zi)[0]
-                out[s] = heldout.fit_percent(target, sim)
+            for first in range(0, coef.shape[0], block):
+                chosen = slice(first, first + block)
+                drive = inputs @ coef[chosen, self.na :].T  # (rows, block)
+                drive += k[chosen]
+                for s, na in enumerate(self.orders[chosen], start=first):
+                    den = np.concatenate([[1.0], -coef[s, :na]])
+                    # lfilter's transposed direct-form state for the measured past outputs
+                    zi = np.array([den[m + 1 :] @ past[: na - m] for m in range(na)])
+                    sim = signal.lfilter([1.0], den, drive[:, s - first], zi=-zi)[0]
+                    out[s] = heldout.fit_percent(target, sim)
         return out
