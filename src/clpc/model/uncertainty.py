@@ -92,14 +92,13 @@ def _shape(model: Any, arr: np.ndarray) -> np.ndarray:
     return arr[0] if model.is_siso else arr
 
 
-def parameter_std(model: Any) -> np.ndarray:
-    """Standard deviations of the monic parameters, shaped like :func:`parameter_vector`.
+def _std(model: Any) -> np.ndarray:
+    return np.sqrt(np.clip(np.diagonal(covariance(model), axis1=1, axis2=2), 0.0, None))
 
-    1-D for a SISO model, else one row per output.
-    """
-    return _shape(
-        model, np.sqrt(np.clip(np.diagonal(covariance(model), axis1=1, axis2=2), 0, None))
-    )
+
+def parameter_std(model: Any) -> np.ndarray:
+    """Standard deviations of the monic parameters: 1-D for a SISO model, else per output."""
+    return _shape(model, _std(model))
 
 
 def confidence_interval(model: Any, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
@@ -111,10 +110,7 @@ def confidence_interval(model: Any, level: float = 0.95) -> tuple[np.ndarray, np
         Ordered like ``np.r_[model.den[1:], model.num]`` (SISO), else one row
         ``np.r_[denominators[j, 1:], numerators[j].ravel()]`` per output.
     """
-    cov = covariance(model)
-    half = _quantile(level, _dof(model))[:, None] * np.sqrt(
-        np.clip(np.diagonal(cov, axis1=1, axis2=2), 0.0, None)
-    )
+    half = _std(model) * _quantile(level, _dof(model))[:, None]
     theta = parameter_vector(model)
     return _shape(model, theta - half), _shape(model, theta + half)
 
@@ -282,17 +278,13 @@ def summary(model: Any) -> str:
         )
     except ModelError as exc:
         sigma, gain_std, how = np.full(theta.shape, np.nan), None, str(exc)
-    lines = [
-        f"{model!r}",
-        f"{_equation(model)}, monic den, coefficient k of z^-k; {how}",
-    ]
+    lines = [f"{model!r}", f"{_equation(model)}, monic den, coefficient k of z^-k; {how}"]
     gains = model.dc_gain()
     for j, name in enumerate(model.output_names):
         lines.append(f"output {name}:")
         for label, v, sd in zip(parameter_labels(model), theta[j], sigma[j], strict=True):
             unc = "" if not np.isfinite(sd) else f" +- {sd:.3g}"
-            fixed = " (fixed: delay)" if label.startswith("b") and v == 0 and sd == 0 else ""
-            lines.append(f"  {label:<12} {v: .6g}{unc}{fixed}")
+            lines.append(f"  {label:<12} {v: .6g}{unc}")
         try:
             poles, pstd = pole_std(model, j) if gain_std is not None else (model.poles(j), None)
         except ModelError:
