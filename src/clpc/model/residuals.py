@@ -76,8 +76,7 @@ class ResidualTest:
 
     def __str__(self) -> str:
         sym = "Q" if self.name.startswith("whiteness") else "zeta"
-        verdict = "passed" if self.passed else "FAILED"
-        rel = "<=" if self.passed else ">"
+        verdict, rel = ("passed", "<=") if self.passed else ("FAILED", ">")
         return (
             f"{self.name}: {sym} = {self.statistic:.3g} {rel} {self.threshold:.3g} "
             f"(chi2 with {self.dof} dof), {self.lags_outside} of {self.n_lags} lags outside "
