@@ -450,14 +450,3 @@ def test_generators_feed_the_servo():
     # a slow ramp is followed within a few mrad (type-1 position loop: lag = slope / Kp)
     slope = 1.0 / 0.9
     assert np.abs(rec.true_position - u).max() < 2 * slope / ServoParameters().position_gain
-
-
-def test_pure_python_fallback_when_numba_is_missing(monkeypatch):
-    monkeypatch.setattr(servo_loop, "_JIT_CACHE", {"loop": None})
-    assert not servo_loop.numba_available()
-    rec = simulate_servo(_step(2, 3), seed=0)  # "auto" falls back to plain Python
-    assert np.all(np.isfinite(rec.position))
-    with pytest.raises(ValueError, match="needs numba"):
-        simulate_servo(_step(2, 3), engine="numba")
-    with pytest.raises(AttributeError, match="numba is not installed"):
-        servo_loop._servo_loop_jit  # noqa: B018

@@ -1,22 +1,6 @@
 """Files: tables (CSV, Parquet, npy/npz, MATLAB .mat) in and out, model files.
 
-Where each job lives (one module each):
-
-- ``table``: the :class:`Table` container, column selection, the shared types;
-- ``errors``: :class:`DataFileNotFoundError` and the one-line bad-cell messages;
-- ``formats``: which format a file is (by its extension), and that it exists;
-- ``text_format``: delimiter and header detection of text files;
-- ``text_reader``: text files read by ``pyarrow.csv`` block by block, the first bad cell
-  named by line, column and text; ``text_lines``: the data lines pyarrow is given (blank
-  and comment lines out, each row's file line kept); ``text_writer``: writing text files;
-- ``parquet``: Parquet in and out; ``numpy_files``: ``.npy``/``.npz`` in and out;
-  ``npz_members``: ``.npz`` arrays read a block of rows at a time; ``mat_files``: MATLAB
-  ``.mat`` in and out (``scipy.io``);
-- ``loading``: :func:`read_table`, :func:`iter_table_chunks` (dispatch by extension);
-- ``records``: :func:`load_iodata`; ``writing``: :func:`write_table`;
-- ``model_schema``: the model file schema and :func:`~clpc.io.model_files.model_to_dict`;
-- ``model_validation``: checking a decoded model file (``model_from_dict``);
-- ``model_files``: :func:`save_model`, :func:`load_model`.
+One module per job; ``docs/architecture.md`` lists them.
 """
 
 from clpc.io.errors import DataFileNotFoundError

@@ -56,17 +56,13 @@ class TextFormat:
     header_line : int or None
         1-based line of the header, None when the file has none.
     data_line : int
-        1-based physical line where data reading starts.
-    units : list of str or None
-        The units row under the header (``s,m,m,V``: every field text), if there is one;
-        it is skipped.
+        1-based physical line where data reading starts (after a units row, if any).
     """
 
     delimiter: str | None
     names: list[str]
     header_line: int | None
     data_line: int
-    units: list[str] | None = None
 
     @property
     def n_cols(self) -> int:
@@ -223,8 +219,7 @@ def sniff(path: Path, delimiter: str | None, header: bool | None, skip_rows: int
     -------
     TextFormat
         Delimiter, column names and where the data starts. A line right under the header
-        whose every field is text (a units row such as ``s,m,m,V``) is recorded in
-        ``units`` and skipped.
+        whose every field is text (a units row such as ``s,m,m,V``) is skipped.
 
     Raises
     ------
@@ -261,7 +256,7 @@ def _layout(
         if len(content) > 1:
             second = split_fields(lines[1], delim)
             if len(second) == len(first) and all(f and not is_number(f) for f in second):
-                return TextFormat(delim, names, content[0][0], content[1][0] + 1, second)
+                return TextFormat(delim, names, content[0][0], content[1][0] + 1)
         return TextFormat(delim, names, content[0][0], content[0][0] + 1)
     names = [f"col{i}" for i in range(len(first))]
     if comments and header is None:  # numpy.savetxt writes its header as "# a,b,c"

@@ -20,7 +20,7 @@ import numpy as np
 
 from clpc.core.polynomials import UNIT_CIRCLE_TOL
 
-__all__ = ["DOMINANT_POLES", "DominantPole", "dominant_poles"]
+__all__ = ["DOMINANT_POLES", "DominantPole", "companion_roots", "dominant_poles"]
 
 #: How many poles (a complex pair counting once) :func:`dominant_poles` returns at most.
 DOMINANT_POLES = 3
@@ -121,3 +121,16 @@ def dominant_poles(model: Any, output: int = 0, count: int = DOMINANT_POLES) -> 
     keep = poles[poles.imag >= -_REAL_TOL * np.maximum(np.abs(poles), 1e-300)]  # pairs once
     order = np.argsort(-np.abs(keep), kind="stable")
     return [_describe(complex(keep[k]), float(model.dt)) for k in order[: max(int(count), 0)]]
+
+
+def companion_roots(den: np.ndarray) -> np.ndarray:
+    """Roots of each monic row of ``den`` (n, m >= 2), shape (n, m - 1); NaN if not finite."""
+    n, m = den.shape
+    comp = np.zeros((n, m - 1, m - 1))
+    comp[:, 0, :] = -den[:, 1:]
+    comp[:, np.arange(1, m - 1), np.arange(m - 2)] = 1.0
+    ok = np.all(np.isfinite(comp), axis=(1, 2))
+    roots = np.full((n, m - 1), np.nan + 0j)
+    if ok.any():
+        roots[ok] = np.linalg.eigvals(comp[ok])
+    return roots

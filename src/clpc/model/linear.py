@@ -93,11 +93,7 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
             object.__setattr__(self, "info", FitInfo(self.info, self, self.record, given))
 
     def __getstate__(self) -> dict[str, Any]:
-        """Pickle without the record: the entries computed so far, nothing pending.
-
-        A pickled model does not carry its record (which would send the data along, e.g.
-        to or from a Dask worker); call :meth:`assess` first to keep all the evidence.
-        """
+        """Pickle without the record (its data): :meth:`assess` first keeps all evidence."""
         state = dict(self.__dict__)
         state["record"] = None
         state["info"] = dict(self.info)
@@ -121,7 +117,6 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
         """``theta`` of every output as rows: shape (n_outputs, p), also for one output."""
         return self._theta2  # type: ignore[attr-defined]
 
-    # ----------------------------------------------------------------- conventions
     @property
     def n_outputs(self) -> int:
         """Number of outputs (equations)."""
@@ -140,8 +135,7 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
     def _a0(self) -> np.ndarray:
         theta = self.theta_matrix
         a0 = theta[:, 0]
-        scale = np.linalg.norm(theta, axis=1)
-        if np.any(np.abs(a0) <= 1e-12 * np.maximum(scale, 1e-300)):
+        if np.any(np.abs(a0) <= 1e-12 * np.maximum(np.linalg.norm(theta, axis=1), 1e-300)):
             j = int(np.argmin(np.abs(a0)))
             raise ModelError(
                 f"a0 of output {j} is about 0 (theta={theta[j].round(6).tolist()}): the "
@@ -149,11 +143,6 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
                 "Check the excitation or lower the order."
             )
         return a0
-
-    def _monic(self) -> tuple[np.ndarray, np.ndarray]:
-        """Both monic polynomials of every output (copies of :meth:`_monic_once`'s)."""
-        den, num = self._monic_once
-        return den.copy(), num.copy()
 
     @functools.cached_property
     def _monic_once(self) -> tuple[np.ndarray, np.ndarray]:
@@ -170,12 +159,12 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
     @property
     def denominators(self) -> np.ndarray:
         """Monic ``A_j(z)`` coefficients, ascending powers of ``z^-1``: shape (n_out, na+1)."""
-        return self._monic()[0]
+        return self._monic_once[0].copy()
 
     @property
     def numerators(self) -> np.ndarray:
         """``-B_ji(z)/a0`` with ``nk`` leading zeros: shape (n_out, n_in, nk+nb+1)."""
-        return self._monic()[1]
+        return self._monic_once[1].copy()
 
     @property
     def intercept(self) -> np.ndarray:
@@ -202,7 +191,6 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
         self._siso("den")
         return self.denominators[0]
 
-    # ----------------------------------------------------------------- analysis
     def poles(self, output: int = 0) -> np.ndarray:
         """Poles (roots of ``z^na A(z)``) of output ``output``'s equation.
 

@@ -1,30 +1,27 @@
 """Residual analysis of a model on a record, like MATLAB SITB's ``resid``.
 
 Residuals ``e(t)`` (from sample ``max_lag`` on, mean removed) are the one-step prediction
-errors of the model's equation (``"prediction"``; for the ARX structure of LPC and least
-squares this is the equation error) or, for an output-error model, the free-run errors
-``y - G u`` (``"simulation"``; chosen by ``"auto"`` when ``info["noise_model"] ==
-"output-error"``). A model that mixes noise models over its outputs gets ``"prediction"``:
-:meth:`LinearModel.predict` is the free run for its output-error outputs, so each output's
-residuals are its own model's errors. With ``N`` residuals, ``M`` lags and ``rho`` the
-normalised sample autocorrelations (``rho_e(k) = sum_t e(t) e(t-k) / sum_t e(t)^2``):
+errors of the model's equation (``"prediction"``; the equation error for LPC and least
+squares) or, for an output-error model, the free-run errors ``y - G u`` (``"simulation"``;
+chosen by ``"auto"`` when ``info["noise_model"] == "output-error"``). A model that mixes
+noise models over its outputs gets ``"prediction"``: :meth:`LinearModel.predict` is the free
+run for its output-error outputs. With ``N`` residuals, ``M`` lags and ``rho`` the normalised
+sample autocorrelations (``rho_e(k) = sum_t e(t) e(t-k) / sum_t e(t)^2``):
 
-**Whiteness** (are the residuals white?): Ljung-Box portmanteau
-``Q = N (N+2) sum_{k=1}^{M} rho_e(k)^2 / (N-k)``, passed when ``Q <= chi2_level(M)``.
+**Whiteness**: Ljung-Box ``Q = N (N+2) sum_{k=1}^{M} rho_e(k)^2 / (N-k)``, passed when
+``Q <= chi2_level(M)``.
 
-**Independence** (are the residuals uncorrelated with past inputs, i.e. is nothing of the
-input's effect left?): with ``r(tau) = sum_t e(t) u(t-tau) / sqrt(sum e^2 sum u^2)`` for
-``tau = 0..M``, ``zeta = N r^T P^-1 r``, where ``P_ab = sum_{|k|<=M} rho_e(k)
-rho_u(k + tau_b - tau_a)`` is the covariance of ``sqrt(N) r`` for ``e`` independent of ``u``
-(Bartlett; ``P`` is the input's correlation matrix when ``e`` is white, so the test also
-holds for colored residuals); passed when ``zeta <= chi2_level(M+1)``.
+**Independence** (nothing of the input's effect left): with ``r(tau) = sum_t e(t) u(t-tau) /
+sqrt(sum e^2 sum u^2)`` for ``tau = 0..M``, ``zeta = N r^T P^-1 r``, where ``P_ab =
+sum_{|k|<=M} rho_e(k) rho_u(k + tau_b - tau_a)`` is the covariance of ``sqrt(N) r`` for ``e``
+independent of ``u`` (Bartlett; it holds for colored residuals too); passed when ``zeta <=
+chi2_level(M+1)``.
 
-The per-lag bands drawn with the correlations are ``+- z / sqrt(N)`` for ``rho_e`` and
-``+- z sqrt(P_aa / N)`` for ``r``, ``z`` the two-sided normal quantile of ``level``
-(2.58 for the default 0.99, as SITB). Under errors-in-variables noise the input noise is
-in the residual too, so even the true model's residuals correlate with the measured input
-(at lags ``nk .. nk+nb``): on long records with noisy inputs the independence test then
-fails for LPC models and says so.
+The per-lag bands are ``+- z / sqrt(N)`` for ``rho_e`` and ``+- z sqrt(P_aa / N)`` for ``r``,
+``z`` the two-sided normal quantile of ``level`` (2.58 for the default 0.99, as SITB). Under
+errors-in-variables noise the input noise is in the residual too, so even the true model's
+residuals correlate with the measured input (at lags ``nk .. nk+nb``): on long records with
+noisy inputs the independence test then fails for LPC models and says so.
 """
 
 from __future__ import annotations
@@ -79,8 +76,7 @@ class ResidualTest:
 
     def __str__(self) -> str:
         sym = "Q" if self.name.startswith("whiteness") else "zeta"
-        verdict = "passed" if self.passed else "FAILED"
-        rel = "<=" if self.passed else ">"
+        verdict, rel = ("passed", "<=") if self.passed else ("FAILED", ">")
         return (
             f"{self.name}: {sym} = {self.statistic:.3g} {rel} {self.threshold:.3g} "
             f"(chi2 with {self.dof} dof), {self.lags_outside} of {self.n_lags} lags outside "
@@ -159,21 +155,18 @@ def _correlations(x: np.ndarray, y: np.ndarray, max_lag: int) -> np.ndarray:
     n = x.shape[0]
     size = 1 << int(np.ceil(np.log2(2 * n)))
     full = np.fft.irfft(np.fft.rfft(x, size) * np.conj(np.fft.rfft(y, size)), size)
-    lags = np.arange(-max_lag, max_lag + 1)
     den = np.sqrt(np.dot(x, x) * np.dot(y, y))
-    return full[lags % size] / (den if den > 0 else 1.0)
+    return full[np.arange(-max_lag, max_lag + 1) % size] / (den if den > 0 else 1.0)
 
 
 def _residuals(model: Any, u: np.ndarray, y: np.ndarray, kind: str) -> np.ndarray:
     start = model.structure.max_lag
     with np.errstate(all="ignore"):
         if kind == "prediction":
-            y_hat = np.asarray(model.predict(u, y, k=1)).reshape(y.shape)[start:]
+            y_hat = np.asarray(model.predict(u, y, k=1))[start:]
         else:
-            y_hat = np.asarray(
-                model.simulate(u[start:], y_init=y[:start], u_init=u[:start])
-            ).reshape(y[start:].shape)
-    e = y[start:] - y_hat
+            y_hat = np.asarray(model.simulate(u[start:], y_init=y[:start], u_init=u[:start]))
+    e = y[start:] - y_hat.reshape(y[start:].shape)
     if not np.all(np.isfinite(e)):
         raise ValueError(
             f"the model's {kind} errors diverge on this record (the model is unstable "
@@ -220,8 +213,7 @@ def residual_analysis(
         Bad arguments, fewer than :data:`MIN_RESIDUALS` residuals, or diverging errors.
     """
     if kind == "auto":
-        oe = {v == "output-error" for v in noise_models(model)}
-        kind = "simulation" if oe == {True} else "prediction"
+        kind = "simulation" if set(noise_models(model)) == {"output-error"} else "prediction"
     if kind not in ("prediction", "simulation"):
         raise ValueError(f"kind must be 'auto', 'prediction' or 'simulation'; got {kind!r}.")
     if not 0.0 < level < 1.0:
@@ -244,11 +236,10 @@ def residual_analysis(
             f"{model.structure.max_lag} initial samples; the record gives {n}."
         )
     m = int(min(max_lag, n // 4))
-    uu = u2[model.structure.max_lag :] - u2[model.structure.max_lag :].mean(axis=0)
+    uu = u2[-n:] - u2[-n:].mean(axis=0)
     from scipy import special  # not scipy.stats, which costs 0.4 s to import
 
     z = float(special.ndtri(0.5 + 0.5 * level))  # the normal quantile
-    lags = np.arange(m + 1)
     auto = np.empty((y2.shape[1], m + 1))
     cross = np.empty((y2.shape[1], u2.shape[1], 2 * m + 1))
     band = np.empty_like(cross)
@@ -256,12 +247,11 @@ def residual_analysis(
     for j, name in enumerate(model.output_names):
         rho_e = _correlations(e[:, j], e[:, j], 2 * m)  # lags -2M..2M
         auto[j] = rho_e[2 * m : 3 * m + 1]
-        q = ljung_box(auto[j, 1:], n)
-        white.append(_test(f"whiteness of {name}", q, m, level, auto[j, 1:], z / np.sqrt(n)))
+        outside = np.abs(auto[j, 1:]) > z / np.sqrt(n)
+        white.append(_count(f"whiteness of {name}", ljung_box(auto[j, 1:], n), m, level, outside))
         for i, inp in enumerate(model.input_names):
             cross[j, i] = _correlations(e[:, j], uu[:, i], m)
-            rho_u = _correlations(uu[:, i], uu[:, i], 2 * m)
-            cov = _bartlett(rho_e, rho_u, m)
+            cov = _bartlett(rho_e, _correlations(uu[:, i], uu[:, i], 2 * m), m)
             # the truncated Bartlett sum can dip below 0 for periodic records: no variance
             var = np.maximum(np.diag(cov), 0.0)[np.abs(np.arange(-m, m + 1))]
             band[j, i] = z * np.sqrt(var / n)
@@ -270,16 +260,15 @@ def residual_analysis(
             outside = np.abs(r) > band[j, i, m:]
             indep.append(_count(f"independence of {name} from {inp}", zeta, m + 1, level, outside))
     return ResidualAnalysis(
-        kind, n, level, lags, auto, z / np.sqrt(n), np.arange(-m, m + 1), cross, band,
+        kind, n, level, np.arange(m + 1), auto, z / np.sqrt(n), np.arange(-m, m + 1), cross, band,
         tuple(white), tuple(indep), e,
     )  # fmt: skip
 
 
 def _bartlett(rho_e: np.ndarray, rho_u: np.ndarray, m: int) -> np.ndarray:
     """``P_ab = sum_{|k|<=M} rho_e(k) rho_u(k + b - a)`` for ``a, b = 0..M``."""
-    k = np.arange(-m, m + 1)
-    d = np.arange(-m, m + 1)  # b - a
-    p_of_d = (rho_e[2 * m + k][None, :] * rho_u[2 * m + k[None, :] + d[:, None]]).sum(axis=1)
+    k = np.arange(-m, m + 1)  # also the values of b - a
+    p_of_d = (rho_e[2 * m + k][None, :] * rho_u[2 * m + k[None, :] + k[:, None]]).sum(axis=1)
     idx = np.arange(m + 1)
     return p_of_d[m + idx[None, :] - idx[:, None]]
 
@@ -304,16 +293,8 @@ def _quadratic(cov: np.ndarray, r: np.ndarray) -> float:
     return float(r @ linalg.cho_solve(factor, r))
 
 
-def _test(
-    name: str, stat: float, dof: int, level: float, r: np.ndarray, bnd: float
-) -> ResidualTest:
-    return _count(name, stat, dof, level, np.abs(r) > bnd)
-
-
 def _count(name: str, stat: float, dof: int, level: float, outside: np.ndarray) -> ResidualTest:
     from scipy import special
 
-    threshold = float(special.chdtri(dof, 1.0 - level))  # the chi-square quantile
-    return ResidualTest(
-        name, stat, threshold, dof, int(outside.sum()), int(outside.size), stat <= threshold
-    )
+    limit = float(special.chdtri(dof, 1.0 - level))  # the chi-square quantile
+    return ResidualTest(name, stat, limit, dof, int(outside.sum()), outside.size, stat <= limit)

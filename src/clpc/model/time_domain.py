@@ -18,10 +18,6 @@ __all__ = ["TimeDomain"]
 class TimeDomain:
     """Free run, ``k``-step prediction and input inference of a model on data."""
 
-    def _forced(self, u: np.ndarray, u_init: np.ndarray | None) -> np.ndarray:
-        """``x_j(n) = sum_i num_ji * u_i + intercept_j``, shape (T, n_out)."""
-        return simulation.forced(self, u, u_init)
-
     def simulate(
         self,
         u: Any,

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.model.dominant import companion_roots
 from clpc.model.errors import ModelError
 from clpc.model.simulation import noise_models
 
@@ -92,29 +93,18 @@ def _shape(model: Any, arr: np.ndarray) -> np.ndarray:
     return arr[0] if model.is_siso else arr
 
 
-def parameter_std(model: Any) -> np.ndarray:
-    """Standard deviations of the monic parameters, shaped like :func:`parameter_vector`.
+def _std(model: Any) -> np.ndarray:
+    return np.sqrt(np.clip(np.diagonal(covariance(model), axis1=1, axis2=2), 0.0, None))
 
-    1-D for a SISO model, else one row per output.
-    """
-    return _shape(
-        model, np.sqrt(np.clip(np.diagonal(covariance(model), axis1=1, axis2=2), 0, None))
-    )
+
+def parameter_std(model: Any) -> np.ndarray:
+    """Standard deviations of the monic parameters: 1-D for a SISO model, else per output."""
+    return _shape(model, _std(model))
 
 
 def confidence_interval(model: Any, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
-    """Two-sided ``level`` intervals ``theta +- t_{dof}(1/2 + level/2) sigma``.
-
-    Returns
-    -------
-    lo, hi : ndarray, shape (q,) for a SISO model, else (n_outputs, q)
-        Ordered like ``np.r_[model.den[1:], model.num]`` (SISO), else one row
-        ``np.r_[denominators[j, 1:], numerators[j].ravel()]`` per output.
-    """
-    cov = covariance(model)
-    half = _quantile(level, _dof(model))[:, None] * np.sqrt(
-        np.clip(np.diagonal(cov, axis1=1, axis2=2), 0.0, None)
-    )
+    """``theta +- t_{dof}(1/2 + level/2) sigma`` (:meth:`LinearModel.confidence_interval`)."""
+    half = _std(model) * _quantile(level, _dof(model))[:, None]
     theta = parameter_vector(model)
     return _shape(model, theta - half), _shape(model, theta + half)
 
@@ -157,13 +147,9 @@ def _split(model: Any, stack: np.ndarray, output: int) -> tuple[np.ndarray, np.n
 
 def _matched_poles(den: np.ndarray, nominal: np.ndarray) -> np.ndarray:
     """Roots of each row of ``den`` (companion eigenvalues), ordered like ``nominal``."""
-    na = den.shape[1] - 1
-    comp = np.zeros((den.shape[0], na, na))
-    comp[:, 0, :] = -den[:, 1:]
-    comp[:, np.arange(1, na), np.arange(na - 1)] = 1.0
     from scipy import optimize
 
-    roots = np.linalg.eigvals(comp)
+    roots = companion_roots(den)
     out = np.empty_like(roots)
     for i, r in enumerate(roots):  # one small assignment per perturbation, not per sample
         _, col = optimize.linear_sum_assignment(np.abs(nominal[:, None] - r[None, :]))
@@ -172,15 +158,9 @@ def _matched_poles(den: np.ndarray, nominal: np.ndarray) -> np.ndarray:
 
 
 def pole_std(model: Any, output: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Poles of one output and the standard deviations of their real and imaginary parts.
+    """Poles of one output and the std of ``(Re p, Im p)``, :meth:`LinearModel.pole_std`.
 
-    Returns
-    -------
-    poles : ndarray of complex, shape (na,)
-        ``model.poles(output)``.
-    std : ndarray, shape (na, 2)
-        Standard deviation of ``(Re p, Im p)`` per pole (delta method; a double pole is not
-        a differentiable function of the parameters and gets no meaningful value).
+    A double pole is not a differentiable function of the parameters: no meaningful std.
     """
     poles = model.poles(output)
     theta = parameter_vector(model)[output]
@@ -212,22 +192,9 @@ def dc_gain_std(model: Any) -> np.ndarray:
 def frequency_response_std(
     model: Any, freqs: np.ndarray | int = 512, output: int = 0, input: int = 0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Frequency response with the standard deviations of its magnitude and phase.
+    """Frequency response and the std of ``|G|`` and ``arg G`` [rad] (delta method).
 
-    Parameters
-    ----------
-    freqs, output, input
-        As for :meth:`LinearModel.frequency_response`.
-
-    Returns
-    -------
-    freqs_hz : ndarray, shape (F,)
-        Frequencies [Hz].
-    response : ndarray of complex, shape (F,)
-    magnitude_std : ndarray, shape (F,)
-        Standard deviation of ``|G|`` (same units as ``|G|``).
-    phase_std : ndarray, shape (F,)
-        Standard deviation of ``arg G`` [rad].
+    See :meth:`LinearModel.frequency_response_std`.
     """
     f, h = model.frequency_response(freqs, output, input)
     theta = parameter_vector(model)[output]
@@ -282,17 +249,13 @@ def summary(model: Any) -> str:
         )
     except ModelError as exc:
         sigma, gain_std, how = np.full(theta.shape, np.nan), None, str(exc)
-    lines = [
-        f"{model!r}",
-        f"{_equation(model)}, monic den, coefficient k of z^-k; {how}",
-    ]
+    lines = [f"{model!r}", f"{_equation(model)}, monic den, coefficient k of z^-k; {how}"]
     gains = model.dc_gain()
     for j, name in enumerate(model.output_names):
         lines.append(f"output {name}:")
         for label, v, sd in zip(parameter_labels(model), theta[j], sigma[j], strict=True):
             unc = "" if not np.isfinite(sd) else f" +- {sd:.3g}"
-            fixed = " (fixed: delay)" if label.startswith("b") and v == 0 and sd == 0 else ""
-            lines.append(f"  {label:<12} {v: .6g}{unc}{fixed}")
+            lines.append(f"  {label:<12} {v: .6g}{unc}")
         try:
             poles, pstd = pole_std(model, j) if gain_std is not None else (model.poles(j), None)
         except ModelError:

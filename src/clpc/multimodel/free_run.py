@@ -24,29 +24,7 @@ def free_run(
     y_init: Any | None,
     u_init: Any | None,
 ) -> np.ndarray:
-    """The blended free run from the input alone (compiled loop).
-
-    Parameters
-    ----------
-    fitted : Fitted
-        The local models, centres and widths.
-    schedule : Schedule
-        The scheduling variable.
-    structure : Structure
-        Orders and delay shared by the local models.
-    n_inputs : int
-        Number of inputs.
-    u : array_like, shape (T,) or (T, n_inputs), or IOData
-        Input samples, or a record of one experiment (its inputs).
-    y_init : array_like, optional
-        Outputs before ``u[0]``, oldest first; ``None`` for zeros.
-    u_init : array_like, optional
-        Inputs before ``u[0]``, oldest first; ``None`` for zeros.
-
-    Returns
-    -------
-    ndarray, shape (T,)
-    """
+    """The blended free run of :meth:`clpc.MultiModel.simulate` (compiled loop), shape (T,)."""
     u2, _ = as_2d(signals(u, what="simulate", needs_y=False)[0], n_inputs, "u")
     s = structure
     pad = max(s.na, s.nk + s.nb, schedule.lag, 1)

@@ -17,23 +17,7 @@ def linearize(
 ) -> LinearModel:
     """The validity-weighted mean of the local models' monic coefficients at one point.
 
-    Parameters
-    ----------
-    fitted : Fitted
-        The local models, centres and widths.
-    structure : Structure
-        Orders and delay shared by the local models.
-    n_inputs : int
-        Number of inputs.
-    dt : float
-        Sample time [s].
-    operating_point : float
-        Value of the scheduling variable (its units) to freeze the validities at.
-
-    Returns
-    -------
-    LinearModel
-        Single output; ``info["operating_point"]`` records the point.
+    :meth:`clpc.MultiModel.linearize`; ``info["operating_point"]`` records the point.
     """
     den, num, icpt = monic_arrays(fitted.local_models)
     phi = validity(np.float64(operating_point), fitted.centres, fitted.widths)

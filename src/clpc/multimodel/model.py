@@ -238,8 +238,7 @@ class MultiModel(ModelFiles):
         -------
         ndarray, shape (T,)
         """
-        f = self._require()
-        sched = self._schedule()
+        f, sched = self._require(), self._schedule()
         return free_run(f, sched, self.structure, self.n_inputs, u, y_init, u_init)
 
     def predict(self, u: Any, y: Any = None, k: int = 1) -> np.ndarray:
@@ -264,8 +263,7 @@ class MultiModel(ModelFiles):
         """
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
             raise ValueError(f"k must be an int >= 1; got {k!r}.")
-        f = self._require()
-        sched = self._schedule()
+        f, sched = self._require(), self._schedule()
         return predict_measured(f, sched, self.structure, self.n_inputs, u, y, k)
 
     def linearize(self, operating_point: float) -> LinearModel:
@@ -285,8 +283,7 @@ class MultiModel(ModelFiles):
         LinearModel
             Single output, ``dt`` the multi-model's; ``info["operating_point"]`` records it.
         """
-        f = self._require()
-        return linearize(f, self.structure, self.n_inputs, self.dt, operating_point)
+        return linearize(self._require(), self.structure, self.n_inputs, self.dt, operating_point)
 
     def __repr__(self) -> str:
         s = self.structure

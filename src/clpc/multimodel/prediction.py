@@ -70,29 +70,7 @@ def predict_measured(
     y: Any,
     k: int,
 ) -> np.ndarray:
-    """:func:`predict_kstep` on measured data given as arrays or a record.
-
-    Parameters
-    ----------
-    fitted : Fitted
-        The local models, centres and widths.
-    schedule : Schedule
-        The scheduling variable.
-    structure : Structure
-        Orders and delay shared by the local models.
-    n_inputs : int
-        Number of inputs.
-    u : array_like, shape (T,) or (T, n_inputs), or IOData
-        Input samples, or a record of one experiment.
-    y : array_like, shape (T,), optional
-        Measured output (required with array inputs).
-    k : int
-        Prediction horizon in samples (>= 1, checked by the caller).
-
-    Returns
-    -------
-    ndarray, shape (T,)
-    """
+    """:func:`predict_kstep` on measured data (:meth:`clpc.MultiModel.predict`; ``k`` checked)."""
     u, y = signals(u, y, what="predict")
     u2, _ = as_2d(u, n_inputs, "u")
     y1 = np.asarray(y, dtype=np.float64).ravel()

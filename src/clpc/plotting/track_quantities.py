@@ -27,6 +27,7 @@ from clpc.core.figure import (
     save_figure,
     time_label,
 )
+from clpc.model.dominant import companion_roots
 
 __all__ = [
     "BAND_PERCENTILES",
@@ -58,13 +59,7 @@ def _dominant(den: np.ndarray) -> np.ndarray:
     n, m = den.shape
     if m < 2:
         return np.full(n, np.nan + 0j)
-    comp = np.zeros((n, m - 1, m - 1))
-    comp[:, 0, :] = -den[:, 1:]
-    comp[:, np.arange(1, m - 1), np.arange(m - 2)] = 1.0
-    ok = np.all(np.isfinite(comp), axis=(1, 2))
-    roots = np.full((n, m - 1), np.nan + 0j)
-    if ok.any():
-        roots[ok] = np.linalg.eigvals(comp[ok])
+    roots = companion_roots(den)
     # the root of largest modulus; of a complex pair, the one with positive imaginary part
     key = np.where(np.isfinite(roots), np.abs(roots) + 1e-12 * np.sign(roots.imag), -1.0)
     return roots[np.arange(n), np.argmax(key, axis=1)]

@@ -1,16 +1,6 @@
-"""Simulated plants and their excitation signals.
+"""Simulated plants and their excitation signals (``docs/architecture.md`` lists the modules).
 
-* :mod:`clpc_paper.plants.servo` - the position-controlled brushless servo of the paper's
-  Fig. 4 (cascaded P position / PI velocity loops, torque low-pass and notch filters,
-  current limit, two-mass mechanics with friction, quantised noisy resolver); its
-  parameters are :mod:`clpc_paper.plants.servo_parameters`, its logs
-  :mod:`clpc_paper.plants.servo_records`, its compiled inner loop
-  :mod:`clpc_paper.plants.servo_loop`;
-* :mod:`clpc_paper.plants.commands` - position commands (the paper's Fig. 5 ramp with
-  saturation, steps, trapezoidal moves) on the sample grid of :mod:`clpc_paper.plants.grid`;
-* :mod:`clpc_paper.plants.excitation` - excitation signals (chirp, PRBS, multisine);
-* :mod:`clpc_paper.plants.crank_servo` - a servo lifting a load through a crank: gravity and
-  inertia that change with the position (issue 18), with its integrator negative control.
+The brushless servo of the paper's Fig. 4, a crank servo (issue 18), position commands.
 """
 
 from clpc_paper.plants.commands import ramp_with_saturation, steps, trapezoid_moves

@@ -9,9 +9,6 @@ rad, times in s.
 * :func:`steps` - piecewise-constant levels;
 * :func:`trapezoid_moves` - repeated point-to-point moves with velocity and acceleration
   limits (trapezoidal velocity profile) and dwell.
-
-The excitation signals (chirp, PRBS, multisine) are in :mod:`clpc_paper.plants.excitation`; they
-are re-exported here, where they used to live.
 """
 
 from __future__ import annotations
@@ -24,19 +21,10 @@ from clpc_paper.checks import check_int
 from clpc_paper.checks import check_nonnegative as nonnegative
 from clpc_paper.checks import check_positive as positive
 from clpc_paper.checks import check_real as real
-from clpc_paper.plants.excitation import chirp, multisine, prbs
-from clpc_paper.plants.grid import EPS, first_index, sample_grid, time_grid
+from clpc_paper.plants.grid import EPS, first_index, sample_grid
 from clpc_paper.plants.moves import MoveCycle, fill_moves
 
-__all__ = [
-    "chirp",
-    "multisine",
-    "prbs",
-    "ramp_with_saturation",
-    "steps",
-    "time_grid",
-    "trapezoid_moves",
-]
+__all__ = ["ramp_with_saturation", "steps", "trapezoid_moves"]
 
 
 def ramp_with_saturation(

@@ -97,9 +97,9 @@ and ``torque_noise_std`` only corrupt the logged signals (errors in variables);
 
 Speed
 -----
-The loop is compiled with numba (optional dependency, extra ``sim``) when available:
-:math:`10^6` logged samples at 10 ms (:math:`5 \cdot 10^7` controller steps) take a few
-seconds. Without numba the same function runs as plain Python (correct but slow).
+The loop is compiled with numba (a dependency of clpc): :math:`10^6` logged samples at 10 ms
+(:math:`5 \cdot 10^7` controller steps) take a few seconds. ``engine="python"`` runs the same
+function as plain Python (correct but slow).
 """
 
 from __future__ import annotations
@@ -159,8 +159,8 @@ def simulate_servo(
     initial_position : float, optional
         Initial motor and load angle [rad], at rest; default ``command[0]``.
     engine : {"auto", "numba", "python"}, optional
-        ``"auto"`` uses the numba-compiled loop when numba is installed, else plain
-        Python; ``"numba"`` requires numba; ``"python"`` forces the (slow) reference.
+        ``"auto"`` and ``"numba"`` use the numba-compiled loop; ``"python"`` forces the
+        (slow) plain-Python reference.
 
     Returns
     -------

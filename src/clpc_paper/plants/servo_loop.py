@@ -3,7 +3,7 @@
 :func:`_servo_loop` runs the drive and the mechanics over one chunk of logged samples; the
 steps it takes are the kernels of :mod:`clpc_paper.plants.servo_kernels`. The same function runs
 as plain Python (``engine="python"``, :data:`_servo_loop_py`) or compiled by numba
-(``numba.njit(cache=True)``: ``_servo_loop_jit``, compiled on first use).
+(``numba.njit(cache=True)``: :data:`_servo_loop_jit`, compiled on first use).
 
 Sample ``i`` is logged at the start of the controller period that begins at ``t_i``: the
 resolver reading the drive uses, the true states and the velocity command computed then.
@@ -16,7 +16,6 @@ position never shows, into the log.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numba
 import numpy as np
@@ -104,18 +103,10 @@ def _servo_loop(config: LoopConfig, inputs: LoopInputs, state: np.ndarray, out: 
     _store_state(state, shaft, drive)
 
 
-#: The loop as plain Python (the reference; always available; the function itself when
-#: ``NUMBA_DISABLE_JIT=1``).
+#: The loop as plain Python (the reference; the function itself when ``NUMBA_DISABLE_JIT=1``).
 _servo_loop_py: Loop = getattr(_servo_loop, "py_func", _servo_loop)
-
-_JIT_CACHE: dict[str, Loop | None] = {}
-
-
-def _compiled_loop() -> Loop | None:
-    """Return the numba-compiled loop, or ``None`` if numba is not installed."""
-    if "loop" not in _JIT_CACHE:
-        _JIT_CACHE["loop"] = _servo_loop
-    return _JIT_CACHE["loop"]
+#: The loop compiled by numba (a dependency of clpc), on its first call.
+_servo_loop_jit: Loop = _servo_loop
 
 
 def numba_available() -> bool:
@@ -124,31 +115,14 @@ def numba_available() -> bool:
     Returns
     -------
     bool
-        ``True`` if :func:`clpc_paper.plants.simulate_servo` runs compiled code by default.
+        ``True``: numba is a dependency of clpc, so :func:`clpc_paper.plants.simulate_servo`
+        runs compiled code by default.
     """
-    return _compiled_loop() is not None
-
-
-def __getattr__(name: str) -> Any:
-    # ``_servo_loop_jit`` is compiled lazily so that importing the module stays cheap.
-    if name == "_servo_loop_jit":
-        loop = _compiled_loop()
-        if loop is None:
-            raise AttributeError("_servo_loop_jit is unavailable: numba is not installed")
-        return loop
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return True
 
 
 def _pick_loop(engine: str) -> Loop:
-    """The loop of ``engine`` (``"auto"``: compiled if numba is installed, else Python)."""
+    """The loop of ``engine``: ``"python"`` plain Python, ``"auto"`` and ``"numba"`` compiled."""
     if check_choice(engine, "engine", ("auto", "numba", "python")) == "python":
         return _servo_loop_py
-    loop = _compiled_loop()
-    if loop is None:
-        if engine == "numba":
-            raise ValueError(
-                "engine='numba' needs numba (a dependency of clpc), which is not installed: "
-                "pip install numba, or pass engine='auto'."
-            )
-        return _servo_loop_py
-    return loop
+    return _servo_loop_jit
