@@ -35,7 +35,8 @@ Then, for winding alone, every least-squares structure identify screens (na 1..1
 nk 0..5 as the input's excitation allows): how many reach 62.9 % (2 points below nfoursid)
 on y2's validation part, and how far below the reference their worst origin falls; and the
 same for a delay of 0 or 1 chosen per input (each of the 32 patterns, ``na/nb`` 1/4, 2/2 and
-1/1, y2 alone; identify has one delay for all inputs).
+1/1, y2 alone; identify has one delay for all inputs); and the subspace model at every
+order 1..10, with and without feedthrough, whatever criterion would choose the order.
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/candidate_rules.py`` (about 1-2 min);
 ``--detail RECORD`` prints every candidate of one record with its scores instead.
@@ -56,7 +57,7 @@ import numpy as np
 import clpc
 from clpc import datasets
 from clpc.lpc.choice import GUARD
-from clpc.lpc.comparison import fold_fits, make, rolling_origin
+from clpc.lpc.comparison import fold_fits, make, rolling_origin, subspace_structure
 from clpc.lpc.heldout import UNIT_CIRCLE_TOL
 from clpc.lpc.screen import screen
 from clpc.lpc.search_space import excited_order, search_space
@@ -288,6 +289,25 @@ def winding_delays() -> None:
     )
 
 
+def winding_subspace() -> None:
+    """winding y2: the subspace model at every order, with and without feedthrough."""
+    rec = load("winding")
+    est = rec.est
+    folds = rolling_origin(est, 0.2)
+    lines = []
+    for nk in (0, 1):
+        for order in range(1, 11):
+            s = subspace_structure(order, nk)
+            windows = scored_parts("subspace", s, "miso", folds, est.n_outputs)[:, 1]
+            val = validation(make("subspace", s, "miso").fit(est), rec)[1]
+            lines.append(
+                f"  order {order} {'with' if nk == 0 else 'without'} feedthrough: validation "
+                f"{val:.1f} %, origins " + ", ".join(f"{w:.1f}" for w in windows)
+            )
+    print("- the subspace model of y2 (both outputs fitted together) at every order:")
+    print("\n".join(lines))
+
+
 def detail(name: str) -> None:
     """Every candidate of one record: its scores on each part and on validation."""
     for r in candidates(load(name)):
@@ -310,3 +330,4 @@ if __name__ == "__main__":
         rules_table()
         winding_grid()
         winding_delays()
+        winding_subspace()
