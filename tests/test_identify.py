@@ -358,3 +358,20 @@ def test_the_screen_memory_does_not_grow_with_the_number_of_structures(monkeypat
         assert np.isfinite(windows).all()
     # 72 structures against 3: one drive column per structure would be 24x the drive memory
     assert peaks[1] < 1.5 * peaks[0] + 2 * 2**20, peaks
+
+
+def test_the_search_fits_and_scores_on_at_most_search_samples_around_each_origin(monkeypatch):
+    u, y = _record(2, "output", n=3000)
+    data = clpc.IOData(u, y, dt=0.1)
+    whole = comparison.rolling_origin(data, 0.2)
+    assert [(a.n_samples, b.n_samples) for a, b in whole] == [
+        (1500, 1500),
+        (2000, 1000),
+        (2400, 600),
+    ]
+    monkeypatch.setattr(comparison, "SEARCH_SAMPLES", 800)
+    capped = comparison.rolling_origin(data, 0.2)
+    assert [(a.n_samples, b.n_samples) for a, b in capped] == [(800, 800), (800, 800), (800, 600)]
+    for (est, val), (full_est, full_val) in zip(capped, whole, strict=True):
+        np.testing.assert_array_equal(est.y, full_est.y[-800:])  # the most recent before
+        np.testing.assert_array_equal(val.y, full_val.y[:800])  # the first after

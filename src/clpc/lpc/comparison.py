@@ -26,6 +26,7 @@ __all__ = [
     "CANDIDATE_NFEV",
     "MAKERS",
     "ORIGINS",
+    "SEARCH_SAMPLES",
     "candidate",
     "final_model",
     "fold_fits",
@@ -44,6 +45,12 @@ MAKERS: dict[str, Any] = {"lpc": LPC, "arx": ARX, "oe": OE, "subspace": Subspace
 #: few % of the cost (a 3,000-sample 4th-order record: 110 evaluations from the closed-form
 #: start; the cost 6 % above the optimum after 40, 2 % after 60, 1e-7 after 75).
 CANDIDATE_NFEV = 60
+#: Samples on each side of an origin that the search fits and scores on (the final model
+#: is fitted on the whole record). Ranking structures and estimators needs the differences
+#: between them to stand out of the noise, not the whole of a long log: 50,000 samples are
+#: 12x the longest shipped record, and they bound the search on any record (on 1e6 samples
+#: the search costs what it costs on about 1.5e5; the final fit is linear in the record).
+SEARCH_SAMPLES = 50_000
 #: The estimator families :func:`clpc.identify` compares, in the order it fits them.
 FAMILIES = ("arx", "lpc", "oe", "subspace")
 
@@ -51,12 +58,14 @@ FAMILIES = ("arx", "lpc", "oe", "subspace")
 def rolling_origin(data: IOData, fraction: float) -> list[tuple[IOData, IOData]]:
     """The (fitted, scored) parts at the rolling origins ``1/2, 2/3, 1 - fraction``.
 
-    At each origin the model is fitted on every sample before it and scored on every sample
-    after it, as the final model is fitted on the record and used after it.
+    At each origin the model is fitted on the samples before it and scored on the samples
+    after it, as the final model is fitted on the record and used after it: every sample,
+    up to :data:`SEARCH_SAMPLES` on each side (the most recent before the origin, the first
+    after it), so the search costs the same on any longer record.
     """
     n = data.n_samples
     cuts = [round(share * n) for share in ORIGINS] + [n - round(fraction * n)]
-    return [(data[:o], data[o:]) for o in cuts]
+    return [(data[max(0, o - SEARCH_SAMPLES) : o], data[o : o + SEARCH_SAMPLES]) for o in cuts]
 
 
 def fold_fits(model: LinearModel, seg: IOData, k: int) -> tuple[np.ndarray, np.ndarray]:
