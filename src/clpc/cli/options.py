@@ -13,7 +13,8 @@ from typing import Any
 
 import click
 
-from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
+from clpc.data.time_units import TIME_UNITS
+from clpc.data.timebase import DEFAULT_TIME_RTOL
 from clpc.workflows import AppraiserSettings, RecordSpec
 
 __all__ = [

@@ -18,7 +18,8 @@ from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
 from clpc.core.output_folder import OutputFolder
 from clpc.data import DataError
-from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
+from clpc.data.time_units import TIME_UNITS, time_unit
+from clpc.data.timebase import MAX_DRIFT_SAMPLES, check_time_base
 from clpc.io import iter_table_chunks, save_model
 from clpc.io.roles import check_column_roles
 from clpc.io.text_format import sniff
