@@ -14,7 +14,8 @@ import clpc
 from clpc.appraiser.tracefile import TraceWriter, trace_columns
 from clpc.cli import cli
 from clpc.data import DataError
-from clpc.data.timebase import check_time_base, measure_time_base, resample_to_grid, time_unit
+from clpc.data.time_units import time_unit
+from clpc.data.timebase import check_time_base, measure_time_base, resample_to_grid
 from clpc.io import iter_table_chunks, load_iodata, read_table, write_table
 
 DT = 1e-3

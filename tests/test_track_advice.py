@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from clpc.cli import cli
-from clpc.data.timebase import time_like
+from clpc.data.time_units import time_like
 from clpc.workflows import AppraiserSettings
 from clpc.workflows.track_advice import excitation_advice
 

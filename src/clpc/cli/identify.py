@@ -16,17 +16,19 @@ from clpc.cli.errors import ClpcCommand
 from clpc.cli.options import (
     OrderType,
     collect,
-    file_argument,
-    input_option,
     json_option,
     method_option,
     na_nb_options,
-    output_option,
-    record_settings,
-    sampling_options,
     save_option,
 )
 from clpc.cli.output import echo_json, warn_unnamed_time
+from clpc.cli.record_options import (
+    file_argument,
+    input_option,
+    output_option,
+    record_settings,
+    sampling_options,
+)
 from clpc.core.output_folder import OutputFolder
 from clpc.lpc.reasons import pct
 from clpc.lpc.selection import ESTIMATORS

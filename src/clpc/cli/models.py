@@ -7,17 +7,15 @@ import sys
 import click
 
 from clpc.cli.errors import ClpcCommand
-from clpc.cli.options import (
-    collect,
+from clpc.cli.options import collect, json_option, model_argument
+from clpc.cli.output import echo_json, write_csv
+from clpc.cli.record_options import (
     file_argument,
     input_option,
-    json_option,
-    model_argument,
     output_option,
     record_settings,
     sampling_options,
 )
-from clpc.cli.output import echo_json, write_csv
 from clpc.report import format_fit
 from clpc.workflows import CompareSettings, compare_file, simulate_file
 

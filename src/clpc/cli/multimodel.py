@@ -5,14 +5,9 @@ from __future__ import annotations
 import click
 
 from clpc.cli.errors import ClpcCommand
-from clpc.cli.options import (
-    file_argument,
-    input_option,
-    json_option,
-    output_option,
-    sampling_options,
-)
+from clpc.cli.options import json_option
 from clpc.cli.output import echo_json
+from clpc.cli.record_options import file_argument, input_option, output_option, sampling_options
 from clpc.workflows.common import RecordSpec
 from clpc.workflows.multimodel import MultiModelSettings, multimodel_file
 

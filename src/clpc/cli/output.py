@@ -11,7 +11,7 @@ import click
 import numpy as np
 
 from clpc.core.jsonable import jsonable
-from clpc.data.timebase import time_like
+from clpc.data.time_units import time_like
 from clpc.io import table_columns
 from clpc.workflows import RecordSpec
 
@@ -36,7 +36,7 @@ def warn_unnamed_time(record: RecordSpec) -> None:
     """One line on stderr when a column is named like sample times but neither dt nor it is given.
 
     Without ``--time``/``--dt`` the sample time is 1 s; beside a column named ``t``,
-    ``t_ms``, ``timestamp``... (:func:`clpc.data.timebase.time_like`) that is rarely meant.
+    ``t_ms``, ``timestamp``... (:func:`clpc.data.time_units.time_like`) that is rarely meant.
     """
     if record.dt is not None or record.time_col is not None:
         return

@@ -10,15 +10,8 @@ from typing import Any
 import click
 
 from clpc.cli.errors import ClpcCommand, _silence_stdout
-from clpc.cli.options import (
-    appraiser_options,
-    appraiser_settings,
-    collect,
-    format_option,
-    input_option,
-    output_option,
-    stream_sampling_options,
-)
+from clpc.cli.options import appraiser_options, appraiser_settings, collect, format_option
+from clpc.cli.record_options import input_option, output_option, stream_sampling_options
 from clpc.cli.stream_io import EXIT_CLOSED_PIPE, Interrupts, Stopped, stdin_batches
 from clpc.workflows import StreamSettings
 from clpc.workflows.stream_session import LineStream

@@ -13,16 +13,18 @@ from clpc.cli.options import (
     appraiser_options,
     appraiser_settings,
     collect,
-    file_argument,
     format_option,
-    input_option,
     out_dir_option,
-    output_option,
-    record_settings,
-    sampling_options,
     save_option,
 )
 from clpc.cli.output import warn_unnamed_time
+from clpc.cli.record_options import (
+    file_argument,
+    input_option,
+    output_option,
+    record_settings,
+    sampling_options,
+)
 from clpc.report import format_model_summary
 from clpc.workflows import (
     Chunk,

@@ -8,15 +8,8 @@ from typing import Any
 import click
 
 from clpc.cli.errors import ClpcCommand
-from clpc.cli.options import (
-    appraiser_options,
-    appraiser_settings,
-    format_option,
-    input_option,
-    out_dir_option,
-    output_option,
-    sampling_options,
-)
+from clpc.cli.options import appraiser_options, appraiser_settings, format_option, out_dir_option
+from clpc.cli.record_options import input_option, output_option, sampling_options
 from clpc.workflows import AppraiserSettings
 
 __all__ = ["track_many"]

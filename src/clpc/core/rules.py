@@ -6,12 +6,8 @@ per-window loop (each is registered with ``numba.extending.register_jitable``). 
 are named constants or fields of :class:`RobustRule`; none is written as a bare literal in
 the logic.
 
-Paper (section III): with lag vectors ``z_n`` (eq. 36), mean ``Z`` (eq. 25) and scatter
-``A = sum (z_n - Z)(z_n - Z)^T`` (eq. 27), the maximum-likelihood ``theta`` under
-``||theta|| = 1`` is the eigenvector of the smallest eigenvalue of ``A`` (eqs. 28-32),
-``c = Z^T theta`` (eq. 24) and ``sigma_r^2 = theta^T A theta / n``.
-
-The problem actually solved is ``T^T A T`` for a transform ``T`` (:data:`NO_TRANSFORM`:
+The paper's solution (section III) is in :mod:`clpc.core.solution`. The problem actually
+solved there is ``T^T A T`` for a transform ``T`` (:data:`NO_TRANSFORM`:
 ``T = I``, the paper; :data:`CHANNEL_SCALES`: each channel divided by its standard
 deviation; :data:`FIXED_TRANSFORM`: ``T^T W T = I`` for a known noise covariance ``W``).
 """
@@ -47,17 +43,6 @@ CHANNEL_SCALES = 1
 #: ... whitened by a known noise covariance (weighted LPC).
 FIXED_TRANSFORM = 2
 
-#: A channel is constant when its largest lag variance (summed over the window) is at
-#: most this fraction of ``lambda_max``: merged statistics of a constant channel are about
-#: 1e-29 of the signal, not exactly 0.
-CONSTANT_CHANNEL_FRACTION = 1e-28
-#: ... or when its per-row standard deviation is at most this fraction of its own size
-#: ``max |mean|`` (a constant offset of 1e4 with rounding noise).
-CONSTANT_CHANNEL_RELATIVE_STD = 1e-12
-#: Largest eigenvalue ratio of one near-null subspace (cap of the Marchenko-Pastur ratio).
-MAX_DEGENERACY_RATIO = 4.0
-#: Entries of a unit vector below this are zero when the sign convention picks its pivot.
-SIGN_PIVOT_TOL = 1e-14
 #: A residual variance below this many machine epsilons of ``lambda_max / n`` is rounding,
 #: not noise: the likelihood uses the floor instead (2.2e-13 relative variance, 126 dB).
 ROUNDING_VARIANCE_FACTOR = 1e3
@@ -90,7 +75,7 @@ class RobustRule:
     ----------
     min_a0_weight : float
         An eigenvector of the solved scatter matrix is a candidate system relation when
-        its unit-free ``y(n)`` weight (:func:`clpc.core.solution.unit_free_weights`) is at
+        its unit-free ``y(n)`` weight (:func:`clpc.core.near_null.unit_free_weights`) is at
         least this (0 < value <= 1). Smaller eigenvectors below the first candidate are
         relations that do not determine ``y(n)``, and a *solution* below it is an input
         relation (:func:`is_input_relation`): it is counted in ``n_input_relations``, is
@@ -108,7 +93,7 @@ class RobustRule:
         vector with ``a0 = 1`` in that subspace. Default: the ratio of the edges of the
         Marchenko-Pastur law, ``((1 + sqrt(p/n)) / (1 - sqrt(p/n)))^2`` (the spread of the
         eigenvalues of pure noise with ``n`` rows and ``p`` columns; 2.0 for ``p = 6, n = 200``
-        and 1.03 for ``n = 1e5``), at most :data:`MAX_DEGENERACY_RATIO`.
+        and 1.03 for ``n = 1e5``), at most :data:`~clpc.core.near_null.MAX_DEGENERACY_RATIO`.
     zero_tol : float
         Eigenvalues below ``zero_tol * lambda_max`` are zero (rounding level): they are
         always in the near-null subspace, whatever their ratios.
@@ -128,30 +113,26 @@ class RobustRule:
 
     def __post_init__(self) -> None:
         a0 = self.min_a0_weight
-        if not (isinstance(a0, (int, float)) and not isinstance(a0, bool) and 0.0 < a0 <= 1.0):
+        if not (_is_number(a0) and 0.0 < a0 <= 1.0):
             raise ValueError(
                 f"RobustRule.min_a0_weight must be a number in (0, 1]; got {a0!r} (a solution "
                 "with no y(n) weight has no monic form)."
             )
-        for name, low, high in (
-            ("zero_tol", 0.0, 1.0),
-            ("min_output_weight", 0.0, 1.0),
-            ("separation", 0.0, 1.0),
-        ):
+        for name in ("zero_tol", "min_output_weight", "separation"):
             value = getattr(self, name)
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-            if not (ok and low <= value <= high):
-                raise ValueError(
-                    f"RobustRule.{name} must be a number in [{low:g}, {high:g}]; got {value!r}."
-                )
+            if not (_is_number(value) and 0.0 <= value <= 1.0):
+                raise ValueError(f"RobustRule.{name} must be a number in [0, 1]; got {value!r}.")
         ratio = self.degeneracy_ratio
-        if ratio is not None and not (
-            isinstance(ratio, (int, float)) and not isinstance(ratio, bool) and ratio >= 1.0
-        ):
+        if ratio is not None and not (_is_number(ratio) and ratio >= 1.0):
             raise ValueError(
                 f"RobustRule.degeneracy_ratio must be None (Marchenko-Pastur) or a number >= 1; "
                 f"got {ratio!r}."
             )
+
+
+def _is_number(value: object) -> bool:
+    """An int or float, not a bool."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 class SolveSettings(NamedTuple):
@@ -291,7 +272,7 @@ def is_input_relation(a0_weight: float, min_a0_weight: float) -> bool:
     """The solution hardly involves ``y(n)``: a relation the input (or past) satisfies.
 
     ``a0_weight`` is the solution's unit-free ``y(n)`` weight
-    (:func:`clpc.core.solution.unit_free_weights`), ``min_a0_weight`` the rule's
+    (:func:`clpc.core.near_null.unit_free_weights`), ``min_a0_weight`` the rule's
     threshold (:class:`RobustRule`, where its value is argued). Such a solution (e.g.
     ``u(n) ~ u(n-1)`` for a smooth input) is not the plant: its monic form divides by a
     ``y(n)`` coefficient near 0 and has arbitrary poles.

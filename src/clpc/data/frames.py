@@ -5,25 +5,26 @@ or us, or of dates), from a column named exactly ``time`` (what :func:`to_frame`
 from a ``DatetimeIndex``/``TimedeltaIndex``; the steps must be uniform by the readers' rule
 (:func:`clpc.data.timebase.check_time_base`), experiment by experiment, or the record is
 refused with what was measured (``resample=True`` interpolates it onto a uniform grid instead).
+:class:`FrameConversion`, a base class of :class:`~clpc.data.IOData`, gives it
+``to_frame``/``from_frame``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
+from clpc.data.time_units import TIME_UNITS, time_unit
 from clpc.data.timebase import (
     DEFAULT_TIME_RTOL,
-    TIME_UNITS,
     check_time_base,
     resample_to_grid,
-    time_unit,
 )
 from clpc.data.validation import DataError, check_dt
 
-__all__ = ["FrameRecord", "from_frame", "to_frame"]
+__all__ = ["FrameConversion", "FrameRecord", "from_frame", "to_frame"]
 
 
 def to_frame(data: Any) -> Any:
@@ -171,3 +172,80 @@ def _uniform_step(
                 "the sample times, or resample the record (resample=True)."
             )
     return step
+
+
+class FrameConversion:
+    """``to_frame`` and ``from_frame`` of a record; a base class of ``IOData``."""
+
+    def to_frame(self) -> Any:
+        """A pandas DataFrame: ``time`` [s], the inputs, the outputs (and ``experiment``)."""
+        return to_frame(self)
+
+    @classmethod
+    def from_frame(
+        cls,
+        frame: Any,
+        inputs: str | Sequence[str],
+        outputs: str | Sequence[str],
+        dt: float | None = None,
+        experiment: str | None = None,
+        *,
+        time_column: str | None = None,
+        time_unit: str | None = None,
+        time_rtol: float = DEFAULT_TIME_RTOL,
+        resample: bool = False,
+    ) -> Self:
+        """A record from DataFrame columns; :meth:`to_frame` round-trips.
+
+        The sample time comes from ``time_column``, else from a column named ``time``, else
+        from a ``DatetimeIndex`` or ``TimedeltaIndex``, else from ``dt`` (default 1). Sample
+        times must step uniformly in each experiment, by the rule of the file readers
+        (:func:`clpc.data.timebase.check_time_base`).
+
+        Parameters
+        ----------
+        frame : pandas.DataFrame
+            The samples, one column per channel.
+        inputs, outputs : str or sequence of str
+            Names of the input and output columns (also the channel names).
+        dt : float, optional
+            Sample time [s]. With sample times in the frame it must agree with their step
+            (within ``time_rtol``); with ``resample`` it is the grid step.
+        experiment : str, optional
+            A column labelling the experiments; each change of label starts a new one.
+        time_column : str, optional
+            A column of sample times: numbers (in ``time_unit``) or dates/durations.
+        time_unit : {"s", "ms", "us"}, optional
+            Unit of a numeric time column; default the one its name says (``t_ms`` is in
+            milliseconds), else seconds.
+        time_rtol : float
+            Largest relative deviation of one step from the median step (default 1e-2, as
+            :func:`clpc.io.load_iodata`).
+        resample : bool
+            Interpolate each experiment onto the uniform grid ``t0 + k dt`` (linear)
+            instead of refusing sample times that are not uniform.
+
+        Returns
+        -------
+        IOData
+
+        Raises
+        ------
+        DataError
+            A missing column; sample times that are not numbers or dates, not increasing or
+            not uniform; a ``dt`` or an experiment whose step disagrees with the first.
+        """
+        make: Callable[..., Self] = cls  # the record's constructor
+        return make(
+            *from_frame(
+                frame,
+                inputs,
+                outputs,
+                dt,
+                experiment,
+                time_column=time_column,
+                time_unit=time_unit,
+                time_rtol=time_rtol,
+                resample=resample,
+            )
+        )

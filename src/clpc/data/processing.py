@@ -3,19 +3,27 @@
 Each function takes the samples of one or more experiments stacked along axis 0 and the
 length of each experiment, and works on every experiment separately (a filter's state, a
 trend or a resampling never crosses from one experiment into the next). They back the
-methods of :class:`~clpc.data.IOData`.
+methods of :class:`Preprocessing`, a base class of :class:`~clpc.data.IOData`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from fractions import Fraction
+from typing import Any, Protocol, Self, TypeVar
 
 import numpy as np
 
-from clpc.data.validation import DataError
+from clpc.data.validation import DataError, check_dt
 
-__all__ = ["detrend_parts", "filter_parts", "resample_parts", "resample_ratio", "split_parts"]
+__all__ = [
+    "Preprocessing",
+    "detrend_parts",
+    "filter_parts",
+    "resample_parts",
+    "resample_ratio",
+    "split_parts",
+]
 
 
 def split_parts(values: np.ndarray, lengths: Sequence[int]) -> list[np.ndarray]:
@@ -151,3 +159,97 @@ def resample_parts(
     if any(p.shape[0] == 0 for p in parts):
         raise DataError(f"an experiment is too short to resample to dt = {new_dt:g} s.")
     return np.concatenate(parts), [p.shape[0] for p in parts]
+
+
+class _Record(Protocol):
+    """What :class:`Preprocessing` uses of the record it is a base of."""
+
+    @property
+    def u(self) -> np.ndarray: ...
+
+    @property
+    def y(self) -> np.ndarray: ...
+
+    @property
+    def dt(self) -> float: ...
+
+    @property
+    def experiments(self) -> tuple[int, ...]: ...
+
+    def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> Self:
+        """A new record with these samples and this record's names."""
+
+
+_R = TypeVar("_R", bound=_Record)
+
+
+class Preprocessing:
+    """``detrend``, ``filter`` and ``resample`` of a record; a base class of ``IOData``."""
+
+    def detrend(self: _R, kind: str = "constant") -> _R:
+        """Remove each channel's mean (``"constant"``) or line (``"linear"``) per experiment.
+
+        Parameters
+        ----------
+        kind : {"constant", "linear"}
+            Remove the mean (default) or the least-squares straight line.
+
+        Returns
+        -------
+        IOData
+        """
+        both = detrend_parts(np.hstack([self.u, self.y]), self.experiments, kind)
+        n_in = self.u.shape[1]
+        return self._with(both[:, :n_in], both[:, n_in:])
+
+    def filter(
+        self: _R,
+        cutoff: float | Sequence[float],
+        btype: str = "lowpass",
+        order: int = 4,
+        zero_phase: bool = True,
+    ) -> _R:
+        """Butterworth-filter every channel (see :func:`filter_parts`).
+
+        ``zero_phase=True`` (default) filters forwards and backwards, so the filter adds no
+        delay (a causal filter would shift the estimated delay ``nk``).
+
+        Parameters
+        ----------
+        cutoff : float or (float, float)
+            Cut-off frequency [Hz] (two for ``"bandpass"``/``"bandstop"``), below the
+            Nyquist frequency ``1 / (2 dt)``.
+        btype : {"lowpass", "highpass", "bandpass", "bandstop"}
+            Filter type; default ``"lowpass"``.
+        order : int
+            Butterworth order (default 4; doubled in effect by ``zero_phase``).
+        zero_phase : bool
+            Filter forwards and backwards (no delay, default) instead of causally.
+
+        Returns
+        -------
+        IOData
+        """
+        both = filter_parts(
+            np.hstack([self.u, self.y]), self.experiments, self.dt, cutoff, btype, order, zero_phase
+        )
+        n_in = self.u.shape[1]
+        return self._with(both[:, :n_in], both[:, n_in:])
+
+    def resample(self: _R, dt: float) -> _R:
+        """The record at sample time ``dt`` [s] (polyphase, anti-aliased; per experiment).
+
+        Parameters
+        ----------
+        dt : float
+            New sample time [s], > 0; ``self.dt / dt`` must be a fraction ``up / down``
+            with ``down <= 1000``.
+
+        Returns
+        -------
+        IOData
+        """
+        new_dt = check_dt(dt)
+        both, parts = resample_parts(np.hstack([self.u, self.y]), self.experiments, self.dt, new_dt)
+        n_in = self.u.shape[1]
+        return self._with(both[:, :n_in], both[:, n_in:], new_dt, parts)

@@ -1,4 +1,4 @@
-"""A record's time column: its unit, how uniform it is, and a uniform grid on request.
+"""A record's time column: how uniform it is, and a uniform grid on request.
 
 One rule for every reader (:func:`clpc.io.load_iodata` on a whole file, ``clpc track`` on
 chunks): the sample time is the mean step, each step may deviate from the typical (median)
@@ -6,12 +6,11 @@ step by at most ``time_rtol`` (relative), and the samples may drift from the uni
 ``t0 + k dt`` by at most :data:`MAX_DRIFT_SAMPLES` of a sample. Real data-acquisition clocks
 jitter (a 1 kHz drive log measured 4e-5 relative); a missing or doubled sample is a step off
 by 100 %, and a clock that drifts off its grid misplaces samples: both are refused, with what
-was measured.
+was measured. The unit of a time column is read by :mod:`clpc.data.time_units`.
 """
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -23,15 +22,12 @@ from clpc.data.validation import DataError
 __all__ = [
     "DEFAULT_TIME_RTOL",
     "MAX_DRIFT_SAMPLES",
-    "TIME_UNITS",
     "TimeBase",
     "check_time_base",
     "measure_time_base",
     "resample_to_grid",
     "rounded_step",
     "step_deviation",
-    "time_like",
-    "time_unit",
 ]
 
 #: Largest relative deviation of one step from the median step accepted by default: 100x
@@ -39,79 +35,6 @@ __all__ = [
 DEFAULT_TIME_RTOL = 1e-2
 #: Largest distance of a sample time from the uniform grid ``t0 + k dt`` [samples].
 MAX_DRIFT_SAMPLES = 0.5
-#: Time units and their length in seconds.
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
-
-_UNIT_WORDS = {
-    "ms": "ms",
-    "msec": "ms",
-    "millis": "ms",
-    "milliseconds": "ms",
-    "us": "us",
-    "usec": "us",
-    "µs": "us",
-    "micros": "us",
-    "microseconds": "us",
-    "s": "s",
-    "sec": "s",
-    "secs": "s",
-    "seconds": "s",
-}
-
-
-def time_unit(unit: str | None, column: str) -> str:
-    """The unit of a time column: ``unit`` if given, else the one its name says, else ``s``.
-
-    Parameters
-    ----------
-    unit : {"s", "ms", "us"} or None
-        The unit asked for; ``None``: detected from the column's name, a word of which
-        (split at non-letters, or a bracketed ``[ms]``) names a unit: ``t_ms``, ``time[ms]``,
-        ``timestamp_us`` are read as milliseconds / microseconds, ``t`` as seconds.
-    column : str
-        The column's name.
-
-    Returns
-    -------
-    str
-        ``"s"``, ``"ms"`` or ``"us"``.
-
-    Raises
-    ------
-    DataError
-        An unknown unit.
-    """
-    if unit is not None:
-        if unit not in TIME_UNITS:
-            raise DataError(f"time unit must be one of {sorted(TIME_UNITS)}; got {unit!r}.")
-        return unit
-    words = [w for w in re.split(r"[^a-zµ]+", str(column).lower()) if w]
-    found = {_UNIT_WORDS[w] for w in words[1:] if w in _UNIT_WORDS}  # "s" alone is a name
-    return found.pop() if len(found) == 1 else "s"
-
-
-#: first words of a column name that says it holds sample times (``t``, ``time_us``)
-_TIME_WORDS = ("t", "time", "timestamp")
-
-
-def time_like(column: str) -> str | None:
-    """The unit of a column named like sample times (``t``, ``t_ms``, ``timestamp``), else None.
-
-    Parameters
-    ----------
-    column : str
-        A column's name: a time word (``t``, ``time``, ``timestamp``), then at most unit words
-        (the rule of :func:`time_unit`), e.g. ``t_s``, ``time[ms]``, ``time_us``.
-
-    Returns
-    -------
-    str or None
-        ``"s"``, ``"ms"`` or ``"us"``; ``None`` for any other name (``t1``, ``torque``).
-    """
-    words = [w for w in re.split(r"[^a-zµ0-9]+", str(column).lower()) if w]
-    if not words or words[0] not in _TIME_WORDS or any(w not in _UNIT_WORDS for w in words[1:]):
-        return None
-    return time_unit(None, column)
 
 
 def rounded_step(step: float) -> float:

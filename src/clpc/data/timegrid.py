@@ -22,13 +22,12 @@ import math
 
 import numpy as np
 
+from clpc.data.time_units import TIME_UNITS, time_unit
 from clpc.data.timebase import (
     DEFAULT_TIME_RTOL,
     MAX_DRIFT_SAMPLES,
-    TIME_UNITS,
     rounded_step,
     step_deviation,
-    time_unit,
 )
 
 __all__ = ["MAX_GAP_SAMPLES", "WARMUP_STEPS", "TimeGrid"]

@@ -16,13 +16,13 @@ import numpy as np
 
 from clpc.data import DataError
 from clpc.data.iodata import IOData, check_dt
+from clpc.data.time_units import TIME_UNITS
+from clpc.data.time_units import time_unit as time_unit_of
 from clpc.data.timebase import (
     DEFAULT_TIME_RTOL,
-    TIME_UNITS,
     check_time_base,
     resample_to_grid,
 )
-from clpc.data.timebase import time_unit as time_unit_of
 from clpc.io.errors import show
 from clpc.io.loading import read_table
 from clpc.io.roles import check_column_roles

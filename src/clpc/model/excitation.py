@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from clpc.core.rules import CONSTANT_CHANNEL_RELATIVE_STD
+from clpc.core.solution import CONSTANT_CHANNEL_RELATIVE_STD
 
 __all__ = [
     "EXCITATION_RTOL",

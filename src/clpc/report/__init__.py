@@ -10,15 +10,9 @@ from clpc.core.jsonable import jsonable
 from clpc.report.comparison import Comparison, compare
 from clpc.report.html import Section, table_html, warnings_html, write_html_report
 from clpc.report.identify import write_identify_report
-from clpc.report.summaries import (
-    model_response,
-    model_summary,
-    steady_state,
-    trace_summary,
-    update_records,
-    verdict_text,
-)
+from clpc.report.summaries import model_response, model_summary, verdict_text
 from clpc.report.text import format_fit, format_model_summary
+from clpc.report.trace_summary import steady_state, trace_summary, update_records
 from clpc.report.track import write_track_report
 
 __all__ = [

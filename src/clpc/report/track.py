@@ -28,7 +28,8 @@ from clpc.plotting.track_quantities import (
 from clpc.plotting.window_tests import plot_window_tests
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
-from clpc.report.summaries import model_summary, steady_state, trace_summary
+from clpc.report.summaries import model_summary
+from clpc.report.trace_summary import steady_state, trace_summary
 
 __all__ = ["trace_warnings", "write_track_report"]
 

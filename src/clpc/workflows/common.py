@@ -14,7 +14,8 @@ from clpc.core.checks import (
     check_positive,
 )
 from clpc.data import IOData
-from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
+from clpc.data.time_units import TIME_UNITS
+from clpc.data.timebase import DEFAULT_TIME_RTOL
 from clpc.io import load_iodata
 from clpc.model import LinearModel
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from clpc.core.checks import check_choice, check_int, check_positive
-from clpc.data.timebase import DEFAULT_TIME_RTOL, TIME_UNITS
+from clpc.data.time_units import TIME_UNITS
+from clpc.data.timebase import DEFAULT_TIME_RTOL
 from clpc.workflows.common import AppraiserSettings, SamplingConflictError, SettingsError
 from clpc.workflows.stream_lines import parse_csv_sample, parse_jsonl_sample
 from clpc.workflows.stream_session import LineStream, StreamBatch

@@ -18,7 +18,7 @@ from clpc.appraiser.tracefile import ThinnedTrace, TraceWriter
 from clpc.core.checks import check_choice, check_int
 from clpc.core.output_folder import OutputFolder
 from clpc.data import DataError
-from clpc.data.timebase import MAX_DRIFT_SAMPLES, TIME_UNITS, check_time_base, time_unit
+from clpc.data.chunked_time import ChunkedTimeBase
 from clpc.io import iter_table_chunks, save_model
 from clpc.io.roles import check_column_roles
 from clpc.io.text_format import sniff
@@ -119,58 +119,6 @@ def count_data_lines(path: str, skip_rows: int = 0) -> int | None:
     return max(lines - before, 1)
 
 
-class _Clock:
-    """Sample time from a time column read in chunks.
-
-    The rule of :func:`clpc.data.timebase.check_time_base`, applied chunk by chunk: the
-    sample time is the first chunk's mean step; later samples keep to its grid as closely.
-    """
-
-    def __init__(self, record: RecordSpec) -> None:
-        self.name = str(record.time_col)
-        self.rtol = record.time_rtol
-        self.unit = record.time_unit
-        self.scale: float | None = None
-        self.last: float | None = None
-        self.dt: float | None = None
-        self.typical = 0.0
-        self.t0 = 0.0
-        self.seen = 0
-
-    def feed(self, t: np.ndarray, name: str) -> None:
-        if t.size == 0:
-            return
-        if self.scale is None:
-            self.scale = TIME_UNITS[time_unit(self.unit, name)]
-        t = t * self.scale
-        if self.dt is None:
-            full = t if self.last is None else np.concatenate([[self.last], t])
-            if full.size >= 2:
-                base = check_time_base(
-                    full, repr(self.name), self.rtol, lambda k: f"data row {k + 1}"
-                )
-                self.dt, self.typical, self.t0 = base.dt, float(np.median(np.diff(full))), full[0]
-        else:
-            steps = np.diff(np.concatenate([[self.last], t]))
-            k = self.seen + np.arange(t.size)
-            dev = np.abs(steps - self.typical) / self.typical
-            drift = np.abs(t - (self.t0 + k * self.dt)) / self.dt
-            bad = np.flatnonzero(~((steps > 0) & (dev <= self.rtol) & (drift <= MAX_DRIFT_SAMPLES)))
-            if bad.size:
-                j = int(bad[0])
-                prev = self.last if j == 0 else t[j - 1]
-                raise DataError(
-                    f"time column {self.name!r} is not uniformly increasing at data row "
-                    f"{self.seen + j + 1} ({prev:.12g} -> {t[j]:.12g}: step deviation "
-                    f"{dev[j]:.2g} relative, {drift[j]:.2g} samples off the grid of dt = "
-                    f"{self.dt:.12g} s; accepted: time_rtol={self.rtol:g}, drift <= "
-                    f"{MAX_DRIFT_SAMPLES:g} samples); resample the record onto a uniform grid, "
-                    "raise --time-rtol if the clock only jitters, or use --dt."
-                )
-        self.last = float(t[-1])
-        self.seen += t.size
-
-
 class _Tail:
     """The last :data:`REPORT_SAMPLES` rows at the appraiser's rate (bounded memory)."""
 
@@ -200,7 +148,11 @@ def _appraise(settings: TrackSettings, trace_file: Path, progress: ChunkFilter |
     """Feed the record to the appraiser chunk by chunk; write every update to ``trace_file``."""
     record = settings.record
     n_in, n_out = len(record.inputs), len(record.outputs)
-    clock = _Clock(record) if record.time_col else None
+    clock = (
+        ChunkedTimeBase(str(record.time_col), record.time_rtol, record.time_unit)
+        if record.time_col
+        else None
+    )
     run: _Run | None = None
     with TraceWriter(trace_file) as writer:
         for names, values in _chunks(record, settings.chunk_rows, progress):
