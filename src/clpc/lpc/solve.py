@@ -16,7 +16,7 @@ under ``||theta|| = 1`` is the eigenvector of the smallest eigenvalue of ``A``
     The literal eigenvector of the smallest eigenvalue of the solved problem (``A`` itself
     with the default ``scaling="none"``).
 ``method="robust"`` (default)
-    See :func:`clpc.core.solution.pick_robust` and ``docs/method.md``.
+    See :func:`clpc.core.near_null.pick_robust` and ``docs/method.md``.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ class SolveResult:
     degenerate : ndarray of bool, shape (batch...)
         The scatter matrix is (numerically) zero or has a constant channel: nothing to fit.
     a0_weight : ndarray, shape (batch...)
-        The solution's unit-free ``y(n)`` weight (:func:`clpc.core.solution.unit_free_weights`);
+        The solution's unit-free ``y(n)`` weight (:func:`clpc.core.near_null.unit_free_weights`);
         near 0 the solution does not determine ``y(n)`` and has no monic form.
     """
 
