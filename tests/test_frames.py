@@ -75,10 +75,18 @@ def test_uneven_sample_times_are_refused_by_the_readers_rule(columns, tmp_path):
 
 
 def test_a_missing_sample_is_named_and_resampling_fills_it(columns):
+    """One time-base rule (as ``clpc stream``): the gap is reported, the samples kept."""
     index = pd.date_range("2024-01-01", periods=N + 1, freq="10ms").delete(50)
     frame = pd.DataFrame(columns, index=index)
+    with pytest.warns(UserWarning, match=r"DatetimeIndex\): 1 sample\(s\) missing before row 50"):
+        kept = clpc.IOData.from_frame(frame, "u", "y")
+    assert kept.dt == 0.01 and kept.n_samples == N  # the mean step between the gaps
+    np.testing.assert_array_equal(kept.u[:, 0], columns["u"])
+    ms = np.arange(N) * 10.0
+    ms[50:] += 5.0  # a step of 1.5 sample times is not dropped samples: refused
+    odd = pd.DataFrame(columns, index=pd.Timestamp("2024-01-01") + pd.to_timedelta(ms, "ms"))
     with pytest.raises(clpc.DataError, match=r"DatetimeIndex\) is not uniformly.*row 49 to row 50"):
-        clpc.IOData.from_frame(frame, "u", "y")
+        clpc.IOData.from_frame(odd, "u", "y")
     filled = clpc.IOData.from_frame(frame, "u", "y", dt=0.01, resample=True)
     assert filled.dt == 0.01 and filled.n_samples == N + 1
     # the filled sample lies on the line between its neighbours

@@ -85,6 +85,50 @@ def test_dropped_sample_is_reported_once_and_later_samples_are_used(tmp_path):
     _same_as_track(updates, _track(tmp_path, text, "--dt", "0.001"), dt_rtol=2e-4)
 
 
+def test_track_reads_the_time_column_across_a_dropped_sample_as_the_stream(tmp_path):
+    """One time-base rule: formerly track refused the file ('not uniformly sampled')."""
+    text, _, _ = _log(drop=[1500])
+    _, updates = _stream(text, "--time", "t")
+    path = tmp_path / "log.csv"
+    path.write_text(text)
+    res = run(
+        "track", path, "-u", "volt", "-y", "pos", "--time", "t", *WINDOW, "--out", tmp_path / "o"
+    )
+    assert res.exit_code == 0, res.output
+    notes = [line for line in res.stderr.splitlines() if "missing" in line]
+    assert len(notes) == 1 and notes[0].startswith(
+        "warning: time column 't': 1 sample(s) missing before data row 1501"
+    ), res.stderr
+    with open(tmp_path / "o" / "trace.csv", newline="") as fh:
+        _same_as_track(updates, list(csv.DictReader(fh)), dt_rtol=2e-4)
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 700])
+def test_gaps_in_the_first_or_a_later_chunk_reanchor_the_grid(tmp_path, monkeypatch, chunk_rows):
+    """Two gaps (1 and 3 samples) on an exact grid: the later samples stay on it."""
+    text, u, y = _log(drop=[300, 1800, 1801, 1802], jitter=0.0, t0=0.0)
+    if chunk_rows is not None:
+        import clpc.workflows.track as track_module
+
+        real = track_module.iter_table_chunks
+        monkeypatch.setattr(
+            track_module, "iter_table_chunks", lambda path, rows, **k: real(path, chunk_rows, **k)
+        )
+    path = tmp_path / "log.csv"
+    path.write_text(text)
+    res = run(
+        "track", path, "-u", "volt", "-y", "pos", "--time", "t", *WINDOW, "--out", tmp_path / "o"
+    )
+    assert res.exit_code == 0, res.output
+    assert "1 sample(s) missing before data row 301" in res.stderr  # kept sample 300
+    assert "3 sample(s) missing" in res.stderr or "4 samples missing in all" in res.stderr
+    with open(tmp_path / "o" / "trace.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ref = clpc.CLPC(order=2, window_size=101, cluster_size=10).run(u, y)  # the kept samples
+    theta = np.array([[float(r[k]) for k in ("a0", "a1", "a2", "b0", "b1", "b2")] for r in rows])
+    np.testing.assert_array_equal(theta, ref.theta)
+
+
 def test_bad_stamp_is_refused_and_the_grid_is_not_lost():
     text, _, _ = _log(jitter=0.0, t0=0.0)
     lines = text.splitlines(keepends=True)
@@ -161,3 +205,31 @@ def test_time_grid_warm_up_gap_is_reported_and_does_not_bias_dt():
     notes = [n for k, s in enumerate(stamps) for n in grid.feed(s, f"line {k + 2}")]
     assert grid.dt == 0.002
     assert len(notes) == 1 and notes[0].startswith("line 5: 1 sample(s) missing")
+
+
+def test_readers_take_a_dropped_sample_with_one_warning_line(tmp_path):
+    text, u, _ = _log(drop=[1000, 1001], jitter=0.0, t0=0.0)
+    path = tmp_path / "log.csv"
+    path.write_text(text)
+    with pytest.warns(UserWarning, match=r"'t' of .*: 2 sample\(s\) missing before line 1002"):
+        data = clpc.load_iodata(path, "volt", "pos", time_column="t")
+    assert data.dt == 1e-3 and data.n_samples == N - 2
+    np.testing.assert_array_equal(data.u[:, 0], u)
+    res = run(
+        "identify",
+        path,
+        "-u",
+        "volt",
+        "-y",
+        "pos",
+        "--time",
+        "t",
+        "--order",
+        "2",
+        "--estimator",
+        "arx",
+    )
+    assert res.exit_code == 0, res.output
+    warned = [line for line in res.stderr.splitlines() if line.startswith("warning:")]
+    assert len(warned) == 1 and "2 sample(s) missing before line 1002" in warned[0]
+    assert "UserWarning" not in res.stderr and "warnings.warn" not in res.stderr

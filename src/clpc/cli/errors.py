@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 import os
 import sys
+import warnings
 from typing import Any
 
 import click
@@ -73,9 +74,15 @@ class ClpcGroup(click.Group):
     """The top-level group: the one place where library errors become one-line messages."""
 
     def invoke(self, ctx: click.Context) -> Any:
-        """Run the subcommand; library errors exit 1 with one line, a closed pipe quietly."""
+        """Run the subcommand; library errors exit 1 with one line, a closed pipe quietly.
+
+        A warning the library issues (e.g. dropped samples in a time column) is one line on
+        stderr, ``warning: ...``, without Python's source location.
+        """
         try:
-            return super().invoke(ctx)
+            with warnings.catch_warnings():
+                warnings.showwarning = _one_line_warning
+                return super().invoke(ctx)
         except (click.ClickException, click.exceptions.Exit, click.exceptions.Abort):
             raise
         except BrokenPipeError:  # the reader went away (e.g. `clpc simulate ... | head`)
@@ -83,3 +90,15 @@ class ClpcGroup(click.Group):
             ctx.exit(1)
         except user_errors() as exc:  # DataError, ModelError, FileNotFoundError, ValueError
             raise click.ClickException(one_line(exc)) from None
+
+
+def _one_line_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """:func:`warnings.showwarning` for the command line: ``warning: <message>`` on stderr."""
+    click.echo(f"warning: {message}", err=True)

@@ -4,9 +4,11 @@ One rule for every reader (:func:`clpc.io.load_iodata` on a whole file, ``clpc t
 chunks): the sample time is the mean step, each step may deviate from the typical (median)
 step by at most ``time_rtol`` (relative), and the samples may drift from the uniform grid
 ``t0 + k dt`` by at most :data:`MAX_DRIFT_SAMPLES` of a sample. Real data-acquisition clocks
-jitter (a 1 kHz drive log measured 4e-5 relative); a missing or doubled sample is a step off
-by 100 %, and a clock that drifts off its grid misplaces samples: both are refused, with what
-was measured. The unit of a time column is read by :mod:`clpc.data.time_units`.
+jitter (a 1 kHz drive log measured 4e-5 relative). A step of a whole number of sample times
+is dropped samples: reported, and the grid re-anchored after it, as a stream does
+(:mod:`clpc.data.time_gaps`). A doubled sample or a step off by a fraction of a sample, and a
+clock that drifts off its grid, misplace samples: they are refused, with what was measured.
+The unit of a time column is read by :mod:`clpc.data.time_units`.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.data.time_gaps import classify_steps, warn_gaps
 from clpc.data.validation import DataError
 
 __all__ = [
@@ -94,6 +97,10 @@ class TimeBase:
         Largest distance of a sample from the grid ``t0 + k dt`` [samples].
     worst_step : int
         0-based index ``k`` of the step ``t[k] -> t[k + 1]`` with the largest deviation.
+    gaps : tuple of (int, int)
+        Dropped samples (:mod:`clpc.data.time_gaps`): the index of the sample after each
+        gap and how many samples it dropped; gaps are left out of ``jitter``, and the grid
+        is re-anchored after each one.
     """
 
     dt: float
@@ -101,6 +108,7 @@ class TimeBase:
     jitter: float
     drift: float
     worst_step: int
+    gaps: tuple[tuple[int, int], ...] = ()
 
     def describe(self) -> str:
         """One line: ``dt = 0.001 s from 12000 samples (jitter 3.4e-05, drift 0.01 samples)``."""
@@ -110,28 +118,42 @@ class TimeBase:
         )
 
 
-def measure_time_base(t: Any) -> TimeBase:
+def measure_time_base(t: Any, rtol: float = DEFAULT_TIME_RTOL) -> TimeBase:
     """Measure a time column without judging it (see :func:`check_time_base`).
 
     Parameters
     ----------
     t : array_like, shape (n,)
         Increasing sample times [s], ``n >= 2``.
+    rtol : float
+        Tolerance that tells a gap of whole sample times from a step that is off
+        (:func:`clpc.data.time_gaps.classify_steps`).
 
     Returns
     -------
     TimeBase
+        The sample time is the mean step between gaps; the drift is measured from the
+        grid re-anchored at the sample after each gap.
     """
     t = np.asarray(t, dtype=np.float64)
     steps = np.diff(t)
     typical = float(np.median(steps))
     dev = step_deviation(steps, typical)
-    step = float((t[-1] - t[0]) / (t.size - 1))
-    dt = rounded_step(step)
-    grid = t[0] + np.arange(t.size) * step
+    missing = classify_steps(steps, typical, rtol)[1] if typical > 0 else np.zeros(0)
+    at = np.flatnonzero(missing)  # gap steps t[j] -> t[j + 1]
+    first = np.concatenate([[0], at + 1])  # first sample of each stretch between gaps
+    last = np.concatenate([at, [t.size - 1]])
+    if at.size:
+        step = float(np.sum(t[last] - t[first]) / max(int(np.sum(last - first)), 1))
+        dev[at] = 0.0
+    else:
+        step = float((t[-1] - t[0]) / (t.size - 1))
+    stretch = np.repeat(np.arange(first.size), last - first + 1)
+    grid = t[first][stretch] + (np.arange(t.size) - first[stretch]) * step
     drift = float(np.max(np.abs(t - grid)) / abs(step)) if step else float("inf")
     worst = int(np.argmax(dev))
-    return TimeBase(dt, int(t.size), float(dev[worst]), drift, worst)
+    gaps = tuple((int(j) + 1, int(missing[j])) for j in at)
+    return TimeBase(rounded_step(step), int(t.size), float(dev[worst]), drift, worst, gaps)
 
 
 def check_time_base(
@@ -156,14 +178,16 @@ def check_time_base(
     Returns
     -------
     TimeBase
-        What was measured.
+        What was measured. Dropped samples (a step of whole sample times) are accepted and
+        reported by one :class:`UserWarning` (:func:`clpc.data.time_gaps.warn_gaps`).
 
     Raises
     ------
     DataError
         Fewer than 2 samples, a step that is not positive, a step off by more than
-        ``rtol``, or a drift from the uniform grid above :data:`MAX_DRIFT_SAMPLES`; the
-        message says what was measured and how to proceed (``resample``).
+        ``rtol`` that is not a gap, or a drift from the uniform grid above
+        :data:`MAX_DRIFT_SAMPLES`; the message says what was measured and how to proceed
+        (``resample``).
     """
     t = np.asarray(t, dtype=np.float64)
     if t.size < 2:
@@ -180,7 +204,7 @@ def check_time_base(
             f"({t[k - 1]:.12g} -> {t[k]:.12g}); sort the record by time and remove repeated "
             "samples."
         )
-    base = measure_time_base(t)
+    base = measure_time_base(t, rtol)
     if base.jitter > rtol or base.drift > MAX_DRIFT_SAMPLES:
         k = base.worst_step + 1
         typical = float(np.median(steps))
@@ -192,6 +216,7 @@ def check_time_base(
             "record onto a uniform grid (resample=True, --resample), or raise time_rtol "
             "(--time-rtol) if the clock only jitters."
         )
+    warn_gaps(name, list(base.gaps), row_label, base.dt)
     return base
 
 

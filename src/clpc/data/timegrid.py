@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from clpc.data.time_gaps import MAX_GAP_SAMPLES
 from clpc.data.time_units import TIME_UNITS, time_unit
 from clpc.data.timebase import (
     DEFAULT_TIME_RTOL,
@@ -32,9 +33,6 @@ from clpc.data.timebase import (
 
 __all__ = ["MAX_GAP_SAMPLES", "WARMUP_STEPS", "TimeGrid"]
 
-#: Longest gap taken at once [sample times]; after a longer one the next sample must confirm
-#: the new grid (a stamp far ahead is more often a bad stamp than a pause).
-MAX_GAP_SAMPLES = 1000
 #: Steps whose mean is a stream's sample time.
 WARMUP_STEPS = 64
 
