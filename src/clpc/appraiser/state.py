@@ -30,7 +30,8 @@ from clpc.appraiser.state_schema import (
     field,
     validate_counters,
 )
-from clpc.appraiser.trace import Trace, TraceLabels, empty_arrays
+from clpc.appraiser.trace import Trace
+from clpc.appraiser.trace_labels import TraceLabels, empty_arrays
 from clpc.core.checks import check_positive
 from clpc.data import DataError
 from clpc.lpc.regressors import miso_regressor
