@@ -8,7 +8,6 @@ and its transition :class:`clpc.appraiser.state.AppraiserState`, one per record.
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 from collections.abc import Callable, Iterable, Iterator
@@ -26,22 +25,11 @@ from clpc.appraiser.inputs import (
     check_chunk,
     check_finite,
 )
+from clpc.appraiser.saved_state import read_state, restored, saved_form, write_state
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.spread import attach_levels
 from clpc.appraiser.state import AppraiserState
-from clpc.appraiser.state_schema import (
-    FORMAT,
-    MAX_STATE_BYTES,
-    VERSION,
-    check_digest,
-    check_header,
-    digest,
-    parse_json,
-    reading_state,
-)
-from clpc.appraiser.state_schema import field as state_field
 from clpc.appraiser.trace import Trace
-from clpc.core.atomic import atomic_file
 from clpc.core.rules import RobustRule
 from clpc.data.samples import check_spread
 
@@ -357,10 +345,7 @@ class CLPC:
 
     def state_dict(self) -> dict[str, Any]:
         """The FSM state and configuration as a JSON-safe dict (floats round-trip exactly)."""
-        out = {"format": FORMAT, "version": VERSION, "config": self.config()}
-        out.update(self._state.to_dict())
-        out["digest"] = digest(out)
-        return out
+        return saved_form(self.config(), self._state)
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> CLPC:
@@ -377,13 +362,10 @@ class CLPC:
             A damaged or edited state: every field is checked first
             (:mod:`clpc.appraiser.state_schema`) and the error names the field.
         """
-        with reading_state():
-            check_header(state)
-            settings = Settings.from_config(state_field(state, "config", dict))
-            appraiser = cls.__new__(cls)
-            appraiser._start(settings)
-            appraiser._state = AppraiserState.from_dict(settings, state)
-            check_digest(state)
+        fsm = restored(state)
+        appraiser = cls.__new__(cls)
+        appraiser._start(fsm.settings)
+        appraiser._state = fsm
         return appraiser
 
     def save(self, path: str) -> None:
@@ -402,8 +384,7 @@ class CLPC:
         clpc.core.atomic.OutputError
             ``path`` is a symbolic link, or writing failed (``path`` is left as it was).
         """
-        with atomic_file(path) as fh:
-            json.dump(self.state_dict(), fh)
+        write_state(path, self.state_dict())
 
     @classmethod
     def load(cls, path: str) -> CLPC:
@@ -419,9 +400,7 @@ class CLPC:
         CLPC
             The appraiser, continuing where the saved one stopped.
         """
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read(MAX_STATE_BYTES + 1)
-        return cls.from_state_dict(parse_json(text))
+        return cls.from_state_dict(read_state(path))
 
     def __repr__(self) -> str:
         return (

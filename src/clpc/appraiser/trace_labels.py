@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.settings import Settings
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.trace_table import PER_EQUATION
 from clpc.model.structure import Structure
@@ -29,6 +30,49 @@ class TraceLabels:
     sample_time: float
     names: tuple[tuple[str, ...], tuple[str, ...]]
     meta: dict[str, Any]
+
+    @classmethod
+    def of_record(
+        cls,
+        settings: Settings,
+        channels: tuple[int, int],
+        names: tuple[tuple[str, ...], tuple[str, ...]] | None,
+        mode: str,
+        sample_time: float,
+    ) -> TraceLabels:
+        """The labels of a record's traces.
+
+        Parameters
+        ----------
+        settings : Settings
+            The appraiser's settings (structure; ``guard``, ``method``, ``scaling`` in ``meta``).
+        channels : (int, int)
+            Inputs and outputs.
+        names : ((str, ...), (str, ...)) or None
+            Channel names (``None``: ``u``, ``y`` or ``u0``, ``u1``, ... ``y0``, ...).
+        mode : {"siso", "paired", "miso"}
+            How outputs relate to inputs.
+        sample_time : float
+            The appraiser's sample time [s].
+        """
+        n_in, n_out = channels
+        names = names or (
+            tuple(f"u{i}" for i in range(n_in)) if n_in > 1 else ("u",),
+            tuple(f"y{i}" for i in range(n_out)) if n_out > 1 else ("y",),
+        )
+        return cls(
+            structure=settings.structure,
+            n_inputs=n_in,
+            mode=mode,
+            sample_time=sample_time,
+            names=names,
+            meta={"guard": settings.guard, "method": settings.method, "scaling": settings.scaling},
+        )
+
+    def empty(self, n_equations: int, p: int) -> Trace:
+        """A trace without updates: ``n_equations`` equations of ``p`` parameters."""
+        z = np.zeros(0, dtype=np.int64)
+        return self.trace(z, z, empty_arrays(n_equations, p, self.structure, self.n_inputs))
 
     def trace(self, index: np.ndarray, rows: np.ndarray, arrays: dict[str, np.ndarray]) -> Trace:
         """A trace of updates ending at samples ``index`` with ``rows`` lag vectors each."""
