@@ -2,79 +2,34 @@
 
 The semantics - samples and lag vectors, windows that grow then slide, an update every
 ``cluster_size`` lag vectors, accept-or-hold, the guard, decimation - are in ``docs/clpc.md``.
-The settings are :class:`clpc.appraiser.settings.Settings` (checked, read-only); the FSM state
-and its transition :class:`clpc.appraiser.state.AppraiserState`, one per record.
+The settings are :class:`clpc.appraiser.settings.Settings` (checked, read-only; each one a
+property, :class:`~clpc.appraiser.settings.SettingsProperties`); the FSM state and its
+transition :class:`clpc.appraiser.state.AppraiserState`, one per record, fed by
+:mod:`clpc.appraiser.feeding` and saved by :mod:`clpc.appraiser.saved_state`; records that are
+not arrays in memory go to the runners of :mod:`clpc.appraiser.runners`.
 """
 
 from __future__ import annotations
 
-import json
-import logging
-import math
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 
-from clpc.appraiser.decimation import Decimator
-from clpc.appraiser.inputs import (
-    SCALAR_TYPES,
-    as_chunk,
-    as_columns,
-    as_record,
-    check_chunk,
-    check_finite,
-)
-from clpc.appraiser.settings import Settings
-from clpc.appraiser.spread import attach_levels
+from clpc.appraiser.feeding import feed_chunk, feed_record, feed_sample
+from clpc.appraiser.inputs import as_chunk
+from clpc.appraiser.runners import register_runner, runner_for
+from clpc.appraiser.saved_state import read_state, restored, saved_form, write_state
+from clpc.appraiser.settings import Settings, SettingsProperties
 from clpc.appraiser.state import AppraiserState
-from clpc.appraiser.state_schema import (
-    FORMAT,
-    MAX_STATE_BYTES,
-    VERSION,
-    check_digest,
-    check_header,
-    digest,
-    parse_json,
-    reading_state,
-)
-from clpc.appraiser.state_schema import field as state_field
 from clpc.appraiser.trace import Trace
-from clpc.core.atomic import atomic_file
 from clpc.core.rules import RobustRule
-from clpc.data.samples import check_spread
 
 __all__ = ["CLPC", "register_runner"]
 
-_LOG = logging.getLogger("clpc.appraiser")
 
-
-#: runners of records that are not arrays in memory (e.g. a ``dask.array``), registered by
-#: the layers above (:mod:`clpc.distributed.long_record`): ``(accepts(x), run(appraiser, u,
-#: y, dt))``; :meth:`CLPC.run` hands a record to the first that accepts ``u`` or ``y``
-_RUNNERS: list[tuple[Callable[[Any], bool], Callable[..., Trace]]] = []
-
-
-def register_runner(accepts: Callable[[Any], bool], run: Callable[..., Trace]) -> None:
-    """Let :meth:`CLPC.run` hand records that ``accepts`` to ``run(appraiser, u, y, dt)``.
-
-    Parameters
-    ----------
-    accepts : callable
-        ``accepts(u_or_y)``: whether the runner takes this record.
-    run : callable
-        ``run(appraiser, u, y, dt)``, returning the :class:`Trace` ``run`` would return.
-    """
-    if (accepts, run) not in _RUNNERS:
-        _RUNNERS.append((accepts, run))
-
-
-def _setting(name: str, doc: str) -> Any:
-    return property(lambda self: getattr(self.settings, name), doc=doc)
-
-
-class CLPC:
+class CLPC(SettingsProperties):
     """The Cluster LPC appraiser: streaming ``step``/``push`` and a vectorised ``run``.
 
     Every setting is named (keyword-only); ``docs/clpc.md`` maps the paper's names to them.
@@ -155,24 +110,6 @@ class CLPC:
         self._map: Callable[..., Iterable[Any]] = map if settings.n_jobs == 1 else self._threads
         self._state = AppraiserState(settings)
 
-    order = _setting("order", "``N``: ``na = nb = N`` unless ``na``/``nb`` are given.")
-    window_size = _setting("window_size", "``W``: lag vectors per LPC.")
-    cluster_size = _setting("cluster_size", "``C``: lag vectors between updates.")
-    dt = _setting("dt", "The data's sample time [s] given to the constructor (or ``None``).")
-    decimate_to = _setting("decimate_to", "Sample time [s] worked at (``None``: the data's).")
-    guard = _setting("guard", "Accept estimates of trusted windows only.")
-    structure = _setting("structure", "The model structure (``na``, ``nb``, ``nk``).")
-    method = _setting("method", "The LPC solve: ``'robust'`` or ``'paper'``.")
-    scaling = _setting("scaling", "Channel scaling of the LPC solve.")
-    mimo = _setting("mimo", "Multi-channel structure (``None``: from the data).")
-    noise_ratio = _setting("noise_ratio", "Known noise ratio of the LPC solve (or ``None``).")
-    noise_cov = _setting("noise_cov", "Known noise covariance of the lag vector (or ``None``).")
-    rule = _setting("rule", "The thresholds of the robust solve.")
-    trust_rows = _setting("trust_rows", "Lag vectors a trusted window needs (``None``: default).")
-    min_rows = _setting("min_rows", "Fewest rows of a usable window (``None``: ``2 p``).")
-    n_jobs = _setting("n_jobs", "Threads of the batched solves.")
-    chunk_samples = _setting("chunk_samples", "Samples processed at a time by :meth:`push`.")
-
     # ================================================================= state
     def reset(self) -> CLPC:
         """Forget all data: empty window, counter 0, no parameters. Returns ``self``."""
@@ -222,25 +159,7 @@ class CLPC:
         Trace
             One row when this sample closes a cluster (an update), else none.
         """
-        s = self._state
-        rows_after = s.n_seen + 1 - s.max_lag
-        update = rows_after > 0 and rows_after % s.cluster == 0
-        if s.plain_siso and type(u_k) in SCALAR_TYPES and type(y_k) in SCALAR_TYPES:
-            # single-channel scalars: plain floats, no arrays until the update
-            u_f, y_f = float(u_k), float(y_k)
-            if not (math.isfinite(u_f) and math.isfinite(y_f)):
-                check_finite(np.array([[u_f]]), "u", s.n_seen)
-                check_finite(np.array([[y_f]]), "y", s.n_seen)
-            return s.keep_aside((u_f, y_f), update, self._map)
-        u = as_columns(u_k, "u").ravel()
-        y = as_columns(y_k, "y").ravel()
-        if s.plain and u.shape == (s.n_in,) and y.shape == (s.n_out,) and not update:
-            sample = np.concatenate([u, y])
-            if not np.all(np.isfinite(sample)):
-                check_finite(u[None], "u", s.n_seen)
-                check_finite(y[None], "y", s.n_seen)
-            return s.keep_aside(sample, False, self._map)
-        return self.push(u[None, :], y[None, :])
+        return feed_sample(self._state, u_k, y_k, self._map)
 
     def push(
         self, u: Any, y: Any, *, progress: Callable[[int, int, int], Any] | None = None
@@ -264,36 +183,8 @@ class CLPC:
             The updates of this chunk (possibly none): consecutive pushes concatenated equal
             :meth:`run` on the whole record.
         """
-        return self._feed(as_chunk(u, y, self._state.n_seen), progress)
-
-    def _feed(
-        self, chunk: tuple[np.ndarray, np.ndarray], progress: Callable[[int, int, int], Any] | None
-    ) -> Trace:
-        """:meth:`push` of a chunk already checked by :func:`as_chunk` (or :func:`check_chunk`)."""
-        s = self._state
-        u2, y2 = chunk
-        n = u2.shape[0]
-        s.init_channels(u2.shape[1], y2.shape[1])
-        if s.decimator is None:
-            s.set_decimator(Decimator(self.settings.factor(None)))
-        decimator = s.decimator
-        assert decimator is not None
-        total = s.updates_after(n)
-        # the kernel writes the updates straight into the final arrays (no copies)
-        out = Trace.allocate(s.empty_trace(), total) if total else s.empty_trace()
-        done, step = 0, self.settings.chunk_samples
-        for lo in range(0, n, step):  # bounded working memory
-            hi = lo + step
-            block = decimator(np.hstack([u2[lo:hi], y2[lo:hi]]))
-            if total:
-                done = s.consume_into(block, self._map, out, done)
-            else:
-                s.consume(block, self._map)  # no update: the samples are only kept
-            _LOG.debug("CLPC: %d of %d samples, %d updates", min(hi, n), n, done)
-            if progress is not None:
-                progress(min(hi, n), n, done)
-        assert done == total, (done, total)
-        return out
+        chunk = as_chunk(u, y, self._state.n_seen)
+        return feed_chunk(self._state, chunk, self._map, progress)
 
     def run(
         self,
@@ -327,22 +218,10 @@ class CLPC:
         :mod:`clpc.distributed` is imported (:func:`clpc.distributed.run_long`; the same
         trace).
         """
-        for accepts, runner in _RUNNERS:
-            if accepts(u) or accepts(y):
-                return runner(self, u, y, dt)
-        s = self.reset()._state
-        u_arr, y_arr, data_dt, names = as_record(u, y, dt)
-        s.init_channels(u_arr.shape[1], y_arr.shape[1], names)
-        factor = self.settings.factor(data_dt)
-        if self.noise_cov is None and self.noise_ratio is None:
-            check_spread(u_arr, y_arr, self.scaling)
-        s.set_decimator(Decimator(factor))
-        if self.decimate_to is None and data_dt is not None:
-            s.record_dt = data_dt  # no decimation: the appraiser works at the data's rate
-        # as_record made them float columns (as push would): only length and finiteness left
-        trace = self._feed(check_chunk(u_arr, y_arr, 0), progress)
-        attach_levels(trace, y_arr, factor)  # the windows' levels (steady state)
-        return trace
+        runner = runner_for(u, y)
+        if runner is not None:
+            return runner(self, u, y, dt)
+        return feed_record(self.reset()._state, (u, y, dt), self._map, progress)
 
     def _threads(self, fn: Callable[..., Any], items: Iterable[Any]) -> Iterator[Any]:
         """``map`` on a thread pool kept for the appraiser's lifetime (made on first use)."""
@@ -357,10 +236,7 @@ class CLPC:
 
     def state_dict(self) -> dict[str, Any]:
         """The FSM state and configuration as a JSON-safe dict (floats round-trip exactly)."""
-        out = {"format": FORMAT, "version": VERSION, "config": self.config()}
-        out.update(self._state.to_dict())
-        out["digest"] = digest(out)
-        return out
+        return saved_form(self.config(), self._state)
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> CLPC:
@@ -377,13 +253,10 @@ class CLPC:
             A damaged or edited state: every field is checked first
             (:mod:`clpc.appraiser.state_schema`) and the error names the field.
         """
-        with reading_state():
-            check_header(state)
-            settings = Settings.from_config(state_field(state, "config", dict))
-            appraiser = cls.__new__(cls)
-            appraiser._start(settings)
-            appraiser._state = AppraiserState.from_dict(settings, state)
-            check_digest(state)
+        fsm = restored(state)
+        appraiser = cls.__new__(cls)
+        appraiser._start(fsm.settings)
+        appraiser._state = fsm
         return appraiser
 
     def save(self, path: str) -> None:
@@ -402,8 +275,7 @@ class CLPC:
         clpc.core.atomic.OutputError
             ``path`` is a symbolic link, or writing failed (``path`` is left as it was).
         """
-        with atomic_file(path) as fh:
-            json.dump(self.state_dict(), fh)
+        write_state(path, self.state_dict())
 
     @classmethod
     def load(cls, path: str) -> CLPC:
@@ -419,9 +291,7 @@ class CLPC:
         CLPC
             The appraiser, continuing where the saved one stopped.
         """
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read(MAX_STATE_BYTES + 1)
-        return cls.from_state_dict(parse_json(text))
+        return cls.from_state_dict(read_state(path))
 
     def __repr__(self) -> str:
         return (

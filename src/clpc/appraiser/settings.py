@@ -1,7 +1,8 @@
 """The settings of an appraiser: one name each, checked once, read-only.
 
 :class:`Settings` is what :class:`clpc.CLPC` is built with (its constructor's arguments, in
-the same order); it holds no state. :meth:`Settings.from_config` reads the saved form,
+the same order); it holds no state. :class:`SettingsProperties` shows each setting as a
+read-only property of the appraiser. :meth:`Settings.from_config` reads the saved form,
 mapping the names of states saved before one name per setting once.
 """
 
@@ -22,7 +23,7 @@ from clpc.core.rules import SCALINGS, RobustRule
 from clpc.data import DataError
 from clpc.model.structure import Structure
 
-__all__ = ["Settings"]
+__all__ = ["Settings", "SettingsProperties"]
 
 #: counts of rows: beyond this no window fits in memory anyway
 _TOP = 2**31 - 1
@@ -169,3 +170,34 @@ class Settings:
             return cls(rule=RobustRule(**rule), **cfg)
         except (TypeError, ValueError) as exc:
             raise StateError(f"state['config'] does not describe an appraiser: {exc}") from None
+
+
+def _setting(name: str, doc: str) -> Any:
+    return property(lambda self: getattr(self.settings, name), doc=doc)
+
+
+class SettingsProperties:
+    """Every setting as a read-only property of an object that holds ``settings``.
+
+    :class:`clpc.CLPC` exposes its :class:`Settings` this way (``appraiser.window_size``).
+    """
+
+    settings: Settings
+
+    order = _setting("order", "``N``: ``na = nb = N`` unless ``na``/``nb`` are given.")
+    window_size = _setting("window_size", "``W``: lag vectors per LPC.")
+    cluster_size = _setting("cluster_size", "``C``: lag vectors between updates.")
+    dt = _setting("dt", "The data's sample time [s] given to the constructor (or ``None``).")
+    decimate_to = _setting("decimate_to", "Sample time [s] worked at (``None``: the data's).")
+    guard = _setting("guard", "Accept estimates of trusted windows only.")
+    structure = _setting("structure", "The model structure (``na``, ``nb``, ``nk``).")
+    method = _setting("method", "The LPC solve: ``'robust'`` or ``'paper'``.")
+    scaling = _setting("scaling", "Channel scaling of the LPC solve.")
+    mimo = _setting("mimo", "Multi-channel structure (``None``: from the data).")
+    noise_ratio = _setting("noise_ratio", "Known noise ratio of the LPC solve (or ``None``).")
+    noise_cov = _setting("noise_cov", "Known noise covariance of the lag vector (or ``None``).")
+    rule = _setting("rule", "The thresholds of the robust solve.")
+    trust_rows = _setting("trust_rows", "Lag vectors a trusted window needs (``None``: default).")
+    min_rows = _setting("min_rows", "Fewest rows of a usable window (``None``: ``2 p``).")
+    n_jobs = _setting("n_jobs", "Threads of the batched solves.")
+    chunk_samples = _setting("chunk_samples", "Samples processed at a time by :meth:`push`.")

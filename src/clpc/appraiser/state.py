@@ -1,9 +1,9 @@
-"""The appraiser's state: the paper's FSM state, its transition and its saved form.
+"""The appraiser's state: the paper's FSM state and its transition.
 
 :class:`AppraiserState` holds the FSM state - the samples the next windows need, the counters, the
 last parameters, the decimation filter - and the transition (:meth:`AppraiserState.consume`:
-new samples in, the updates they complete out). :meth:`AppraiserState.to_dict` /
-:meth:`AppraiserState.from_dict` are its saved form, checked by :mod:`.state_schema`.
+new samples in, the updates they complete out). Its saved form is
+:mod:`clpc.appraiser.saved_state` (:meth:`AppraiserState.resume` continues from it).
 """
 
 from __future__ import annotations
@@ -18,20 +18,9 @@ from clpc.appraiser import kernel
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator
 from clpc.appraiser.settings import Settings
-from clpc.appraiser.state_schema import (
-    FORMAT,
-    VERSION,
-    StateError,
-    checked_array,
-    checked_decimator,
-    checked_flags,
-    checked_names,
-    digest,
-    field,
-    validate_counters,
-)
-from clpc.appraiser.trace import Trace, TraceLabels, empty_arrays
-from clpc.core.checks import check_positive
+from clpc.appraiser.state_schema import FORMAT, VERSION, digest
+from clpc.appraiser.trace import Trace
+from clpc.appraiser.trace_labels import TraceLabels
 from clpc.data import DataError
 from clpc.lpc.regressors import miso_regressor
 from clpc.model.structure import check_mode, default_mode
@@ -140,23 +129,36 @@ class AppraiserState:
         """What the traces of this record say besides the numbers."""
         if self.labels is not None:
             return self.labels
-        n_in, n_out = self.n_in or 1, self.n_out or 1
-        names = self.names or (
-            tuple(f"u{i}" for i in range(n_in)) if n_in > 1 else ("u",),
-            tuple(f"y{i}" for i in range(n_out)) if n_out > 1 else ("y",),
-        )
-        st = self.settings
-        labels = TraceLabels(
-            structure=st.structure,
-            n_inputs=n_in,
-            mode=self.mode() if self.n_in is not None else "siso",
-            sample_time=self.time_step(),
-            names=names,
-            meta={"guard": st.guard, "method": st.method, "scaling": st.scaling},
-        )
+        channels = (self.n_in or 1, self.n_out or 1)
+        mode = self.mode() if self.n_in is not None else "siso"
+        labels = TraceLabels.of_record(self.settings, channels, self.names, mode, self.time_step())
         if self.n_in is not None:
             self.labels = labels
         return labels
+
+    def resume(
+        self,
+        samples: tuple[np.ndarray, int],
+        counts: tuple[int, int],
+        model: tuple[np.ndarray, np.ndarray, np.ndarray],
+        record_dt: float | None,
+    ) -> None:
+        """Continue from a saved point (:mod:`.saved_state`; every value checked by it).
+
+        ``samples``: the kept decimated samples (n, n_in + n_out) and the absolute index of
+        the first; ``counts``: ``n_seen``, ``j_done``; ``model``: ``last_theta`` (n_out, p),
+        ``last_c`` (n_out,), ``has_model`` (n_out,); ``record_dt``: the data's sample time
+        [s] when the appraiser works at it (else ``None``). The channels are set first.
+        """
+        assert self.buffer is not None
+        data, start = samples
+        if data.size:
+            self.buffer.data = data
+        self.buffer.start = start
+        self.n_seen, self.j_done = counts
+        self.last_theta, self.last_c, self.has_model = model
+        if record_dt is not None:
+            self.record_dt = record_dt
 
     # ------------------------------------------------------------ the transition
     def lag_rows(self, buf: np.ndarray) -> np.ndarray:
@@ -289,74 +291,8 @@ class AppraiserState:
         """A trace without updates, shaped for the record's channels (cached once known)."""
         if self.empty is not None:
             return self.empty
-        s = self.settings.structure
-        p = self.n_params() if self.n_in is not None else s.n_params()
-        arrays = empty_arrays(self.n_out or 1, p, s, self.n_in or 1)
-        z = np.zeros(0, dtype=np.int64)
-        empty = self.trace_labels().trace(z, z, arrays)
+        p = self.n_params() if self.n_in is not None else self.settings.structure.n_params()
+        empty = self.trace_labels().empty(self.n_out or 1, p)
         if self.n_in is not None:
             self.empty = empty
         return empty
-
-    # ------------------------------------------------------------ the saved form
-    def to_dict(self) -> dict[str, Any]:
-        """The state as JSON-safe data (floats round-trip exactly), without the settings."""
-        buf, dec = self.buffer, self.decimator
-        if buf is not None:
-            buf.flush()
-        return {
-            "n_in": self.n_in,
-            "n_out": self.n_out,
-            "names": None if self.names is None else [list(n) for n in self.names],
-            "buf": _arr(np.empty((0, 0)) if buf is None else buf.data),
-            "buf_start": 0 if buf is None else buf.start,
-            "n_seen": self.n_seen,
-            "j_done": self.j_done,
-            "last_theta": _arr(self.last_theta),
-            "last_c": _arr(self.last_c),
-            "has_model": None if self.has_model is None else self.has_model.tolist(),
-            "factor": None if dec is None else dec.factor,
-            "dec_zi": None if dec is None else _arr(dec.zi),
-            "dec_phase": 0 if dec is None else dec.phase,
-            "record_dt": self.record_dt,
-        }
-
-    @classmethod
-    def from_dict(cls, settings: Settings, state: dict[str, Any]) -> AppraiserState:
-        """The state saved by :meth:`to_dict`, every field checked (:class:`StateError`)."""
-        new = cls(settings)
-        n_in, n_out = state.get("n_in"), state.get("n_out")
-        n_seen, j_done = field(state, "n_seen", int), field(state, "j_done", int)
-        if n_in is None or n_out is None:
-            if n_in is not None or n_out is not None or n_seen or j_done:
-                raise StateError("a state without channels (n_in, n_out) must have seen nothing.")
-            return new
-        n_in, n_out = field(state, "n_in", int), field(state, "n_out", int)
-        if n_in < 1 or n_out < 1:
-            raise StateError(f"n_in and n_out must be >= 1; got {n_in}, {n_out}.")
-        new.init_channels(n_in, n_out, checked_names(state.get("names"), n_in, n_out))
-        buf = checked_array(field(state, "buf", dict), "buf", (None, n_in + n_out))
-        start = field(state, "buf_start", int)
-        sizes = (new.max_lag, settings.window_size, settings.cluster_size)
-        validate_counters((n_seen, j_done, start, buf.shape[0]), sizes)
-        assert new.buffer is not None and new.last_theta is not None
-        if buf.size:
-            new.buffer.data = buf
-        new.buffer.start = start
-        new.n_seen, new.j_done = n_seen, j_done
-        p = new.last_theta.shape[1]
-        new.last_theta = checked_array(state.get("last_theta"), "last_theta", (n_out, p))
-        new.last_c = checked_array(state.get("last_c"), "last_c", (n_out,))
-        new.has_model = checked_flags(state.get("has_model"), new.last_theta)
-        if state.get("factor") is not None:
-            new.set_decimator(
-                Decimator(*checked_decimator(state, n_in + n_out, settings.decimate_to))
-            )
-        record_dt = state.get("record_dt")
-        if record_dt is not None:
-            new.record_dt = check_positive(record_dt, "state['record_dt']", "s")
-        return new
-
-
-def _arr(x: np.ndarray | None) -> Any:
-    return None if x is None else {"shape": list(x.shape), "data": x.ravel().tolist()}

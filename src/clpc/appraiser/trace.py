@@ -1,7 +1,8 @@
 """The output of the appraiser: one row per cluster update, plus the convergence verdict.
 
-:class:`TraceLabels` is what a trace says about its appraiser besides the numbers;
-:func:`empty_arrays` the arrays of a trace without updates.
+The keys of its arrays and its table layout are in :mod:`clpc.appraiser.trace_table`; how
+the traces of one record are made (:class:`~clpc.appraiser.trace_labels.TraceLabels`) in
+:mod:`clpc.appraiser.trace_labels`.
 """
 
 from __future__ import annotations
@@ -14,35 +15,12 @@ import numpy as np
 from clpc.appraiser import convergence
 from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION, Convergence
 from clpc.appraiser.convergence import steady_state_model as steady_state
+from clpc.appraiser.trace_table import PER_EQUATION, SCALAR_KEYS, theta_labels, trace_frame
 from clpc.core.compact import compact_repr
 from clpc.model import LinearModel
 from clpc.model.structure import Structure
 
-__all__ = ["MIN_TRUSTED_FRACTION", "Convergence", "Trace", "TraceLabels", "empty_arrays"]
-
-# per-update scalar statistics of each equation: shape (n_updates, n_equations)
-SCALAR_KEYS = (
-    "D",
-    "lambda_min",
-    "lambda_max",
-    "eig_ratio",
-    "separation",
-    "a0_weight",
-    "noise_variance",
-    "J",
-    "c",
-    "n_null",
-    "n_input_relations",
-    "degenerate",
-    "determined",
-    "excited",
-    "trusted",
-    "accepted",
-    "has_model",
-    "stable",
-)
-# every per-update array; axis 1 (when present) is the equation (output) axis
-PER_EQUATION = ("theta", "theta_estimate", "den", "num", "eigenvalues", *SCALAR_KEYS)
+__all__ = ["MIN_TRUSTED_FRACTION", "PER_EQUATION", "SCALAR_KEYS", "Convergence", "Trace"]
 
 
 @compact_repr
@@ -237,32 +215,11 @@ class Trace:
     # ----------------------------------------------------------------- views
     def labels(self) -> list[str]:
         """Names of the entries of ``theta``: ``a0 .. a_na, b0 .. b_nb`` per input block."""
-        s = self.structure
-        names = [f"a{i}" for i in range(s.na + 1)]
-        n_blocks = self.n_inputs if self.mode == "miso" else 1
-        for blk in range(n_blocks):
-            suffix = f"_{self.input_names[blk]}" if n_blocks > 1 else ""
-            names += [f"b{i}{suffix}" for i in range(s.nb + 1)]
-        return names
+        return theta_labels(self)
 
     def to_frame(self) -> Any:
         """The trace as a pandas DataFrame (one row per update; needs pandas)."""
-        import pandas as pd
-
-        cols: dict[str, Any] = {
-            "index": self.index,
-            "time": self.time,
-            "rows": self.rows,
-            "not_enough_data": self.not_enough_data,
-        }
-        labels = self.labels()
-        for e in range(self.n_equations):
-            pre = f"{self.output_names[e]}:" if self.n_equations > 1 else ""
-            for i, lab in enumerate(labels):
-                cols[pre + lab] = self.arrays["theta"][:, e, i]
-            for key in SCALAR_KEYS:
-                cols[pre + key] = self.arrays[key][:, e]
-        return pd.DataFrame(cols)
+        return trace_frame(self)
 
     def take(self, rows: Any) -> Trace:
         """The updates ``rows`` as a trace of their own.
@@ -356,57 +313,3 @@ class Trace:
 
 
 _FIELD_NAMES = {f.name for f in fields(Trace)}
-
-
-@dataclass(frozen=True)
-class TraceLabels:
-    """What a trace says about its appraiser besides the numbers."""
-
-    structure: Structure
-    n_inputs: int
-    mode: str
-    sample_time: float
-    names: tuple[tuple[str, ...], tuple[str, ...]]
-    meta: dict[str, Any]
-
-    def trace(self, index: np.ndarray, rows: np.ndarray, arrays: dict[str, np.ndarray]) -> Trace:
-        """A trace of updates ending at samples ``index`` with ``rows`` lag vectors each."""
-        index = np.asarray(index, dtype=np.int64)
-        return Trace.of(
-            {
-                "index": index,
-                "time": index * self.sample_time,
-                "rows": np.asarray(rows, dtype=np.int64),
-                "not_enough_data": arrays.pop("not_enough"),
-                "arrays": arrays,
-                "structure": self.structure,
-                "n_inputs": self.n_inputs,
-                "mode": self.mode,
-                "sample_time": self.sample_time,
-                "input_names": self.names[0],
-                "output_names": self.names[1],
-                "meta": dict(self.meta),
-            }
-        )
-
-
-def empty_arrays(
-    n_equations: int, p: int, structure: Structure, n_inputs: int
-) -> dict[str, np.ndarray]:
-    """Zero-row per-equation arrays of the right shapes and types (an empty trace)."""
-    s = structure
-    shapes = {
-        "theta": (p,),
-        "theta_estimate": (p,),
-        "den": (s.na + 1,),
-        "num": (n_inputs, s.nk + s.nb + 1),
-        "eigenvalues": (p,),
-    }
-    ints = ("n_null", "n_input_relations")
-    bools = ("degenerate", "determined", "excited", "trusted", "accepted", "has_model", "stable")
-    arrays: dict[str, np.ndarray] = {}
-    for key in PER_EQUATION:
-        dtype = np.int64 if key in ints else (np.bool_ if key in bools else np.float64)
-        arrays[key] = np.zeros((0, n_equations, *shapes.get(key, ())), dtype=dtype)
-    arrays["not_enough"] = np.zeros(0, dtype=np.bool_)
-    return arrays

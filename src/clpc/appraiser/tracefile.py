@@ -2,8 +2,9 @@
 
 A record of 1e7 samples gives about 8e5 cluster updates; keeping every row of their trace in
 memory costs about 300 bytes each. :class:`TraceWriter` appends the rows of each part to the
-trace file as they arrive, and :class:`ThinnedTrace` keeps at most ``2 * max_updates`` of them
-for figures and summaries (every update until the cap, then every 2nd, 4th, ... update).
+trace file as they arrive (the columns of :func:`clpc.appraiser.trace_table.trace_columns`),
+and :class:`ThinnedTrace` keeps at most ``2 * max_updates`` of them for figures and summaries
+(every update until the cap, then every 2nd, 4th, ... update).
 """
 
 from __future__ import annotations
@@ -20,81 +21,12 @@ from typing import Any
 import numpy as np
 
 from clpc.appraiser.thinned import ThinnedTrace
-from clpc.appraiser.trace import SCALAR_KEYS, Trace
+from clpc.appraiser.trace import Trace
+from clpc.appraiser.trace_table import is_integer, trace_column_list, trace_columns
 from clpc.core.atomic import OutputError, atomic_path
 from clpc.data import DataError
 
 __all__ = ["ThinnedTrace", "TraceWriter", "trace_column_list", "trace_columns"]
-
-
-def trace_column_list(trace: Trace) -> tuple[list[str], list[np.ndarray]]:
-    """A trace's columns, each in its own type (see :func:`trace_columns` for the layout).
-
-    Returns
-    -------
-    names : list of str
-    columns : list of ndarray, shape (n_updates,)
-        ``int64`` for counts and flags (``index``, ``rows``, ``n_null``, ``accepted``, ...),
-        ``float64`` for everything else.
-    """
-    names = ["index", "time", "rows", "not_enough_data"]
-    cols = [trace.index, trace.time, trace.rows, trace.not_enough_data]
-    labels = trace.labels()
-    a = trace.arrays
-    s = trace.structure
-    for e in range(trace.n_equations):
-        pre = f"{trace.output_names[e]}:" if trace.n_equations > 1 else ""
-        for i, lab in enumerate(labels):
-            names.append(pre + lab)
-            cols.append(a["theta"][:, e, i])
-        for i in range(s.na + 1):
-            names.append(f"{pre}den{i}")
-            cols.append(a["den"][:, e, i])
-        for u in range(a["num"].shape[2]):
-            suffix = f"_{trace.input_names[u]}" if a["num"].shape[2] > 1 else ""
-            for i in range(a["num"].shape[3]):
-                names.append(f"{pre}num{i}{suffix}")
-                cols.append(a["num"][:, e, u, i])
-        for key in SCALAR_KEYS:
-            names.append(pre + key)
-            cols.append(a[key][:, e])
-    typed = [
-        np.asarray(c, dtype=np.int64 if _is_integer(c) else np.float64)
-        for c in map(np.asarray, cols)
-    ]
-    return names, typed
-
-
-def _is_integer(col: np.ndarray) -> bool:
-    return bool(np.issubdtype(col.dtype, np.integer) or np.issubdtype(col.dtype, np.bool_))
-
-
-def trace_columns(trace: Trace) -> tuple[list[str], np.ndarray]:
-    """A trace as a numeric table: column names and a float array (one row per update).
-
-    Columns: ``index``, ``time``, ``rows``, ``not_enough_data``, then per output (prefixed
-    ``"<output>:"`` when there are several) the ``theta`` entries (:meth:`Trace.labels`),
-    the monic ``den``/``num`` coefficients and the statistics of :func:`update_records`;
-    flags are 0/1.
-
-    Parameters
-    ----------
-    trace : Trace
-        A CLPC trace.
-
-    Returns
-    -------
-    names : list of str
-        Column names.
-    table : ndarray, shape (n_updates, n_columns)
-    """
-    names, cols = trace_column_list(trace)
-    table = (
-        np.column_stack([c.astype(np.float64) for c in cols])
-        if len(trace)
-        else np.zeros((0, len(names)))
-    )
-    return names, table
 
 
 def _arrow() -> Any:
@@ -205,7 +137,7 @@ class TraceWriter:
             else:
                 self._fh = tmp.open("w", encoding="utf-8")
                 self._fh.write(header.decode())
-                formats = ["%d" if _is_integer(c) else "%r" for c in cols]
+                formats = ["%d" if is_integer(c) else "%r" for c in cols]
                 self._row_format = ",".join(formats) + "\n"
             return
         import pyarrow as pa  # a dependency of clpc, imported when a Parquet trace is written
@@ -214,7 +146,7 @@ class TraceWriter:
         self._pa = pa
         schema = pa.schema(
             [
-                (n, pa.int64() if _is_integer(c) else pa.float64())
+                (n, pa.int64() if is_integer(c) else pa.float64())
                 for n, c in zip(names, cols, strict=True)
             ]
         )
