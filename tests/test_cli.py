@@ -288,7 +288,7 @@ def test_track_errors(record, tmp_path):
     r = fails(1, "track", path, "-u", "u", "-y", "y", "--window-size", "5000", "--out", tmp_path)
     assert "too short for the window" in r.output and "needs at least 5002" in r.output
     bad_time = tmp_path / "bad_time.csv"
-    write_table(bad_time, ["t", "u", "y"], [[0, 1, 2], [0.1, 2, 3], [0.3, 3, 4], [0.4, 1, 1]])
+    write_table(bad_time, ["t", "u", "y"], [[0, 1, 2], [0.1, 2, 3], [0.25, 3, 4], [0.35, 1, 1]])
     r = fails(1, "track", bad_time, "-u", "u", "-y", "y", "--time", "t", "--out", tmp_path)
     assert "not uniformly" in r.output
     fails(2, "track", path, "-u", "u", "-y", "y", "--out", tmp_path, "--dt", "1", "--time", "t")

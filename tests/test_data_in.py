@@ -47,11 +47,15 @@ def test_real_jitter_is_accepted_and_measured(tmp_path):
 
 
 def test_irregular_time_is_refused(tmp_path):
-    t = np.delete(np.arange(100) * DT, 40)  # a missing sample: one step is doubled
+    t = np.arange(100) * DT
+    t[40:] += 0.5 * DT  # one step of 1.5 sample times: neither jitter nor dropped samples
     with pytest.raises(DataError, match=r"line 41 to line 42 .* time_rtol=0.01"):
         path = tmp_path / "gap.csv"
         write_table(path, ["t", "u", "y"], np.column_stack([t, t, t]))
         load_iodata(path, "u", "y", time_column="t")
+    dropped = np.delete(np.arange(100) * DT, 40)  # one step doubled: a dropped sample, used
+    base = measure_time_base(dropped)
+    assert base.gaps == ((40, 1),) and base.dt == DT and base.drift < 1e-9
     drifting = np.cumsum(np.full(400, DT) * (1 + 0.008 * np.sign(np.arange(400) - 200)))
     base = measure_time_base(drifting)  # each step within 1 %, but the clock walks away
     assert base.jitter < 1e-2 and base.drift > 0.5
