@@ -23,10 +23,12 @@ single-process trace array by array (SHA-256 of every array: bit for bit).
 
 Each distributed run is repeated ``--repeat`` times and the fastest kept (as ``single``).
 Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
-computing (summed over the task stream, by task: solve, piece info, finish) and this
-process's CPU time (receiving, joining or scanning the parts); the scheduler overhead per
-piece = (N x wall - computing) / pieces (time a worker was not computing: scheduling,
-transfers, waiting for a core or for the client); bytes per piece sent between
+computing (summed over the task stream, by task: solve, piece info, finish); the CPU time
+of each worker process and of this process (the client and the local cluster's scheduler:
+receiving, joining or scanning the parts) - on a loaded machine the CPU times say more than
+the wall time; the scheduler overhead per piece = (N x wall - computing) / pieces (time a
+worker was not computing: scheduling, transfers, waiting for a core or for the client);
+bytes per piece sent between
 workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
 (the pickled size of every result); peak RSS of each worker and of this process (added by
 the run). The load average is printed before and after: the machine may be shared.
@@ -152,6 +154,7 @@ def distributed_runs(
         for mode in [m for m in ("run_long", "track_long") for _ in range(repeat)]:
             base = _incoming_bytes(client)
             rss0 = _peak_rss_mb()
+            cpu0 = client.run(time.process_time)
             with distributed.get_task_stream(client) as ts:
                 t0, c0 = time.perf_counter(), time.process_time()
                 if mode == "run_long":
@@ -164,6 +167,8 @@ def distributed_runs(
                     updates = result.summary["updates"]
                     result.close()
                 client_cpu = time.process_time() - c0
+            cpu1 = client.run(time.process_time)
+            worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
             equal, to_client = None, None
             if mode == "run_long":  # checked after the timing
                 equal = digests(trace) == reference["digests"]
@@ -186,6 +191,7 @@ def distributed_runs(
                     "workers": n_workers,
                     "wall": wall,
                     "client_cpu": client_cpu,
+                    "worker_cpu": worker_cpu,
                     "updates": updates,
                     "equal": equal,
                     "pieces": pieces,
@@ -212,7 +218,8 @@ def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     print(
         f"    {row['pieces']} pieces; computing {sum(secs.values()):.2f} s (solve "
         f"{secs.get('solve_piece', 0.0):.2f}, piece info {info:.2f}, finish {finish:.2f})"
-        f"; client CPU {row['client_cpu']:.2f} s"
+        f"; CPU: workers {' + '.join(f'{c:.2f}' for c in row['worker_cpu'])} s, this "
+        f"process (client and scheduler) {row['client_cpu']:.2f} s"
         f"; scheduler overhead per piece {1e3 * row['overhead_per_piece']:.1f} ms"
     )
     print(

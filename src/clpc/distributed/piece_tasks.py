@@ -198,11 +198,11 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
     """
     if isinstance(raw, tuple):
         u, y = as_chunk(raw[0], raw[1], piece.raw[0])
-    else:
+        both = np.hstack([u, y])
+    else:  # float64 [inputs | outputs] as read: checked column by column, not copied
         both = raw.read(*piece.raw)
         n_in = plan.channels[0]
         u, y = as_chunk(both[:, :n_in], both[:, n_in:], piece.raw[0])
-    both = np.hstack([u, y])
     samples = _kept(both, plan.layout, piece)
     setup = plan.state().kernel_setup()
     first_row = piece.kept[0] - plan.layout.max_lag
