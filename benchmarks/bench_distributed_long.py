@@ -21,10 +21,14 @@ Every cluster is started once per ``N``, warmed up on a short record (numba's co
 kernel is loaded in each worker), then timed. The ``run_long`` trace is compared with the
 single-process trace array by array (SHA-256 of every array: bit for bit).
 
+Each distributed run is repeated ``--repeat`` times and the fastest kept (as ``single``).
 Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
-computing (summed over the task stream, by task: solve, fsm = the sequential chain, finish)
-and the scheduler overhead per piece = (N x wall - computing) / pieces (time a worker was
-not computing: scheduling, transfers, waiting for the chain); bytes per piece sent between
+computing (summed over the task stream, by task: solve, piece info, finish); the CPU time
+of each worker process and of this process (the client and the local cluster's scheduler:
+receiving, joining or scanning the parts) - on a loaded machine the CPU times say more than
+the wall time; the scheduler overhead per piece = (N x wall - computing) / pieces (time a
+worker was not computing: scheduling, transfers, waiting for a core or for the client);
+bytes per piece sent between
 workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
 (the pickled size of every result); peak RSS of each worker and of this process (added by
 the run). The load average is printed before and after: the machine may be shared.
@@ -131,7 +135,7 @@ def _incoming_bytes(client: Any) -> int:
 
 
 def distributed_runs(
-    path: str, n_workers: int, reference: dict[str, Any], tmp: Path
+    path: str, n_workers: int, reference: dict[str, Any], tmp: Path, repeat: int = 1
 ) -> list[dict[str, Any]]:
     """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes."""
     import distributed
@@ -147,11 +151,12 @@ def distributed_runs(
     with dask_client(workers=n_workers) as client:
         for _ in range(2):  # every worker loads the kernel
             run_long(CLPC(), NpySource(str(warm), (0,), (1,)), client=client, piece_samples=10_000)
-        for mode in ("run_long", "track_long"):
+        for mode in [m for m in ("run_long", "track_long") for _ in range(repeat)]:
             base = _incoming_bytes(client)
             rss0 = _peak_rss_mb()
+            cpu0 = client.run(time.process_time)
             with distributed.get_task_stream(client) as ts:
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 if mode == "run_long":
                     trace = run_long(CLPC(), source, client=client)
                     wall = time.perf_counter() - t0
@@ -160,6 +165,10 @@ def distributed_runs(
                     result = track_long(CLPC(), source, tmp / f"out{n_workers}", client=client)
                     wall = time.perf_counter() - t0
                     updates = result.summary["updates"]
+                    result.close()
+                client_cpu = time.process_time() - c0
+            cpu1 = client.run(time.process_time)
+            worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
             equal, to_client = None, None
             if mode == "run_long":  # checked after the timing
                 equal = digests(trace) == reference["digests"]
@@ -181,6 +190,8 @@ def distributed_runs(
                     "mode": mode,
                     "workers": n_workers,
                     "wall": wall,
+                    "client_cpu": client_cpu,
+                    "worker_cpu": worker_cpu,
                     "updates": updates,
                     "equal": equal,
                     "pieces": pieces,
@@ -197,7 +208,7 @@ def distributed_runs(
 
 def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     secs, wall = row["seconds"], row["wall"]
-    chain = secs.get("fsm_piece", 0.0) + secs.get("end_state", 0.0)
+    info = secs.get("piece_info", 0.0)
     finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
     print(
         f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
@@ -206,8 +217,9 @@ def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     )
     print(
         f"    {row['pieces']} pieces; computing {sum(secs.values()):.2f} s (solve "
-        f"{secs.get('solve_piece', 0.0):.2f}, sequential FSM chain {chain:.2f} = "
-        f"{100 * chain / wall:.1f} % of the wall time, finish {finish:.2f})"
+        f"{secs.get('solve_piece', 0.0):.2f}, piece info {info:.2f}, finish {finish:.2f})"
+        f"; CPU: workers {' + '.join(f'{c:.2f}' for c in row['worker_cpu'])} s, this "
+        f"process (client and scheduler) {row['client_cpu']:.2f} s"
         f"; scheduler overhead per piece {1e3 * row['overhead_per_piece']:.1f} ms"
     )
     print(
@@ -222,7 +234,7 @@ def main() -> None:
     parser.add_argument("--samples", type=float, default=1e7)
     parser.add_argument("--quick", action="store_true", help="1e6 samples")
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
-    parser.add_argument("--repeat", type=int, default=1, help="single-process repetitions")
+    parser.add_argument("--repeat", type=int, default=1, help="repetitions of each run (best kept)")
     parser.add_argument("--single-worker", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.single_worker:
@@ -248,8 +260,9 @@ def main() -> None:
             f"peak RSS added {ref['rss_added_mb']:.0f} MB"
         )
         for w in args.workers:
-            for row in distributed_runs(str(path), w, ref, tmp):
-                _show(row, n, ref)
+            rows = distributed_runs(str(path), w, ref, tmp, args.repeat)
+            for mode in ("run_long", "track_long"):
+                _show(min((r for r in rows if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
     print(f"\nload average after: {os.getloadavg()}")
 
 

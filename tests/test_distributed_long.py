@@ -271,3 +271,49 @@ def test_clpc_track_workers_writes_what_clpc_track_writes(tmp_path):
     bad = runner.invoke(cli, [*common[:2], "--workers", "2", "-u", "0", "-y", "1", "--time", "t",
                               "--out", str(tmp_path / "x")])  # fmt: skip
     assert bad.exit_code != 0 and "--dt" in bad.output
+
+
+def test_each_output_carries_its_own_held_model_across_pieces(client):
+    # two outputs; output 1 is zero over 4000 samples, so equation 1 accepts nothing in
+    # several pieces while equation 0 accepts in every one: the state a piece starts in
+    # comes from different pieces for the two equations
+    rng = np.random.default_rng(8)
+    u = rng.standard_normal((14_003, 2))
+    y = np.column_stack(
+        [
+            signal.lfilter([0.4, 0.2], [1.0, -0.6], u[:, 0]),
+            signal.lfilter([1.0, 0.5], [1, -0.3], u[:, 1]),
+        ]
+    ) + 0.01 * rng.standard_normal((14_003, 2))
+    y[5_000:9_000, 1] = 0.0
+    kw = {"order": 1, "window_size": 70, "cluster_size": 7}
+    ref = CLPC(**kw).run(u, y)
+    held = ~ref.accepted[:, 1] & ref.has_model[:, 1]
+    assert held.sum() > 3 * 600 // 7 and ref.accepted[:, 0][held].all()
+    u_d, y_d = da.from_array(u, chunks=(3_000, 2)), da.from_array(y, chunks=(3_000, 2))
+    got = run_long(CLPC(**kw), u_d, y_d, client=client, piece_samples=600)
+    _assert_same(ref, got)
+
+
+def test_the_long_summary_is_clpc_tracks_bit_for_bit(client, tmp_path):
+    import json
+
+    import clpc.workflows as wf
+    from clpc.distributed import track_long
+
+    u, y = _record(30_007, quiet=(12_000, 15_000))
+    np.save(tmp_path / "rec.npy", np.column_stack([u, y]))
+    appraiser = wf.AppraiserSettings(order=2, window_size=90, cluster_size=10)
+    record = wf.RecordSpec(str(tmp_path / "rec.npy"), ("0",), ("1",))
+    plain = wf.track_file(wf.TrackSettings(record, str(tmp_path / "plain"), appraiser,
+                                           chunk_rows=1_000))  # fmt: skip
+    source = open_source(tmp_path / "rec.npy", (0,), (1,))
+    done = track_long(appraiser.build(None), source, tmp_path / "long", client=client,
+                      piece_samples=1_300)  # fmt: skip
+    done.close()
+    written = (tmp_path / "long" / "summary.json").read_text()
+    assert plain.summary["updates"] == len(CLPC(window_size=90, cluster_size=10).run(u, y))
+    assert json.loads(written) == done.summary
+    # the summary JSON of clpc track (the advice aside: made from the report's data)
+    want = {k: v for k, v in plain.summary.items() if k != "advice"}
+    assert json.dumps(done.summary, indent=1) == json.dumps(want, indent=1)

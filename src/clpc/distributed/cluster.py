@@ -99,7 +99,8 @@ def dask_client(
             processes=True,
             dashboard_address=":0",
         ) as cluster,
-        distributed.Client(cluster) as local,
+        # results straight from the workers (by default they pass through the scheduler)
+        distributed.Client(cluster, direct_to_workers=True) as local,
     ):
         if announce is not None:
             announce(

@@ -2,10 +2,12 @@
 
 The record is cut into pieces of consecutive updates (:mod:`clpc.distributed.pieces`). Per
 piece, a worker reads its samples (a memory-mapped ``.npy`` slice, Parquet row groups, or
-a slice of a ``dask.array`` computed on the workers: no sample passes through the client)
-and solves its windows; a cheap chain of tasks then runs the finite-state machine piece
-after piece, each passing on the few numbers of its end state; last, each piece's trace
-rows are built (returned, or written by the worker as one file of a Parquet dataset).
+a slice of a ``dask.array`` computed on the workers: no sample passes through the client),
+solves its windows and runs the finite-state machine over them from "no model yet"; the
+client carries the FSM state from piece to piece (a few numbers each), and the worker
+redoes the piece's first updates, up to each equation's first accepted one, from that
+state (:mod:`.piece_tasks`); last, each piece's trace rows are built (returned, or written
+by the worker as one file of a Parquet dataset).
 Pieces in flight are bounded (:mod:`.schedule`), so memory stays O(piece).
 
 The trace equals ``CLPC(...).run(u, y)`` bit for bit without decimation; with decimation
@@ -63,6 +65,7 @@ def plan_record(
     n_raw: int,
     dt: float | None = None,
     names: tuple[tuple[str, ...], tuple[str, ...]] | None = None,
+    levels: bool = True,
 ) -> RecordPlan:
     """The plan of a record of ``n_raw`` samples for ``appraiser`` (its settings, decimation).
 
@@ -77,23 +80,26 @@ def plan_record(
         The data's sample time [s] (default the appraiser's ``dt``).
     names : ((str, ...), (str, ...)), optional
         Input and output names.
+    levels : bool
+        Compute the windows' mean output levels (``meta["window_level"]`` of the trace).
     """
     settings = appraiser.settings
     factor = settings.factor(dt)
     record_dt = dt if settings.decimate_to is None else None
     layout = Layout(settings.window_size, settings.cluster_size, settings.structure.max_lag, factor)
-    return RecordPlan(settings, channels, names, record_dt, layout, n_raw)
+    return RecordPlan(settings, channels, names, record_dt, layout, n_raw, levels)
 
 
 def gather(parts: list[Trace]) -> Trace:
-    """The record's trace from its pieces' traces (window levels joined)."""
+    """The record's trace from its pieces' traces (window levels joined, when they have them)."""
     total = sum(len(p) for p in parts)
     trace = Trace.allocate(parts[0], total)
     done = 0
     for part in parts:
         done = trace.put(done, part)
-    levels = [p.meta["window_level"] for p in parts]
-    trace.meta["window_level"] = np.concatenate(levels)
+    trace.meta.pop("window_level", None)
+    if all("window_level" in p.meta for p in parts):
+        trace.meta["window_level"] = np.concatenate([p.meta["window_level"] for p in parts])
     return trace
 
 

@@ -5,9 +5,11 @@
 partitioned Parquet dataset ``OUT/trace/part-NNNNNN.parquet`` (the columns of
 :func:`clpc.appraiser.tracefile.trace_columns`, in time order by file name; readable with
 ``pandas.read_parquet("OUT/trace")`` or ``pyarrow.dataset``) and sends back only the
-per-update arrays the summary reads (about a third of a row). The summary
-(:func:`clpc.report.trace_summary`: counts, convergence, findings, the steady-state model)
-is computed from all updates and written to ``OUT/summary.json``.
+per-update arrays the summary reads (about a third of a row). The client feeds them, piece
+by piece in update order, to the :class:`clpc.appraiser.scanned.ScannedTrace` that plain
+``clpc track`` uses, and lets them go: its memory does not grow with the record, and the
+summary (:func:`clpc.report.trace_summary`: counts, convergence, findings, the
+steady-state model), written to ``OUT/summary.json``, is ``clpc track``'s bit for bit.
 
 The dataset is written into a hidden folder and renamed to ``OUT/trace`` when every piece
 is complete: a failed or killed run leaves the previous dataset (or none), never a part.
@@ -20,7 +22,9 @@ import dataclasses
 import json
 import os
 import shutil
+import tempfile
 import uuid
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,11 +33,13 @@ import numpy as np
 
 from clpc.appraiser import CLPC
 from clpc.appraiser.decimation import Decimator
+from clpc.appraiser.scanned import ScannedTrace
+from clpc.appraiser.trace import Trace
 from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
 from clpc.distributed.long_record import check_peaks, gather, plan_record
-from clpc.distributed.piece_tasks import RecordPlan, write_piece
+from clpc.distributed.piece_tasks import RecordPlan, WrittenPiece, write_piece
 from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
 from clpc.distributed.sources import NpySource, ParquetSource, open_source
@@ -71,7 +77,7 @@ class LongTrack:
     Attributes
     ----------
     summary : dict
-        :func:`clpc.report.trace_summary` of every update.
+        :func:`clpc.report.trace_summary` of every update (as ``clpc track``'s).
     model : LinearModel or None
         The steady-state model (``None``: no update was accepted).
     model_source : str
@@ -91,6 +97,12 @@ class LongTrack:
     parts: int
     appraised: Appraised
 
+    def close(self) -> None:
+        """Remove the summary's scratch file (the report is made of ``appraised``)."""
+        whole = self.appraised.whole
+        if isinstance(whole, ScannedTrace):
+            whole.close()
+
 
 def track_long(
     appraiser: CLPC,
@@ -103,7 +115,6 @@ def track_long(
     workers: int | None = None,
     piece_samples: int | None = None,
     figure_updates: int = 20_000,
-    window_levels: bool = True,
 ) -> LongTrack:
     """Appraise a record file on a Dask cluster; the workers write the trace as a dataset.
 
@@ -121,17 +132,15 @@ def track_long(
         Where to run (:func:`clpc.distributed.dask_client`).
     piece_samples : int, optional
         Decimated samples per piece (default
-        :func:`clpc.distributed.long_record.default_piece_samples`).
+        :func:`clpc.distributed.schedule.default_piece_samples`).
     figure_updates : int
         The report's figures show at most about twice this many updates (as ``clpc track``).
-    window_levels : bool
-        Keep the windows' levels (``meta["window_level"]``, as :meth:`clpc.CLPC.run`) for
-        the summary's findings; ``False``: without them, as ``clpc track`` (which reads a
-        record in chunks) summarises.
 
     Returns
     -------
     LongTrack
+        Call its :meth:`LongTrack.close` when done with its report (it removes the
+        summary's scratch file).
 
     Raises
     ------
@@ -143,7 +152,7 @@ def track_long(
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     channels = (len(source.inputs), len(source.outputs))
-    plan = plan_record(appraiser, channels, source.length(), dt, source.names())
+    plan = plan_record(appraiser, channels, source.length(), dt, source.names(), levels=False)
     total = plan.layout.updates(plan.n_raw)
     if total == 0:
         raise DataError(
@@ -154,30 +163,47 @@ def track_long(
     staging = folder / f".trace-{uuid.uuid4().hex}"
     stride = thinning_stride(total, figure_updates)
     finish = (write_piece, (str(staging.resolve()), SUMMARY_KEYS, (stride, RECENT)))
+    taken = _Taken(ScannedTrace(Path(tempfile.gettempdir())))
     try:
         with dask_client(client, scheduler, workers) as dask:
-            parts, peaks = run_pieces(dask, plan, source, piece_samples, finish)
+            _, peaks = run_pieces(dask, plan, source, piece_samples, finish, sink=taken.add)
             tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False).result()
         check_peaks(appraiser, peaks, channels[0])
-        whole = gather([p.summary for p in parts])
-        if not window_levels:
-            meta = {k: v for k, v in whole.meta.items() if k != "window_level"}
-            whole = dataclasses.replace(whole, meta=meta)
-        summary = trace_summary(whole)
+        summary = trace_summary(taken.whole)
         _replace(staging, folder / "trace")
+        write_file(folder / "summary.json", json.dumps(summary, indent=1))
+        model, model_source = steady_state(taken.whole)
+    except BaseException:
+        taken.whole.close()
+        raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-    write_file(folder / "summary.json", json.dumps(summary, indent=1))
-    model, model_source = steady_state(whole)
-    figures = gather([p.figures for p in parts])
+    figures = gather(taken.figures)
     figures = dataclasses.replace(
         figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
     )
-    last = gather([p.last for p in parts[-2:]])
+    last = gather(list(taken.last))
     recent = last.take(np.arange(max(len(last) - RECENT, 0), len(last)))
     n_kept = plan.layout.kept(plan.n_raw)
-    done = Appraised(appraiser.config(), n_kept, figures, whole, recent, tail)
-    return LongTrack(summary, model, model_source, folder / "trace", len(parts), done)
+    done = Appraised(appraiser.config(), n_kept, figures, taken.whole, recent, tail)
+    return LongTrack(summary, model, model_source, folder / "trace", taken.parts, done)
+
+
+class _Taken:
+    """What the client keeps of the written pieces, taken in time order (bounded memory)."""
+
+    def __init__(self, whole: ScannedTrace) -> None:
+        self.whole = whole  # every update's summary arrays, scanned and let go
+        self.figures: list[Trace] = []  # every stride-th update: ~2 figure_updates in all
+        self.last: deque[Trace] = deque(maxlen=2)  # the last RECENT updates are in these
+        self.parts = 0
+
+    def add(self, part: WrittenPiece) -> None:
+        self.whole.add(part.summary)
+        if len(part.figures):
+            self.figures.append(part.figures)
+        self.last.append(part.last)
+        self.parts += 1
 
 
 def thinning_stride(updates: int, figure_updates: int) -> int:
@@ -245,10 +271,12 @@ def track_settings(
         scheduler=scheduler,
         workers=workers,
         figure_updates=settings.figure_updates,
-        window_levels=False,
     )
     out = Path(settings.out_dir)
-    result = write_report(settings, done.appraised, done.dataset, out)
+    try:
+        result = write_report(settings, done.appraised, done.dataset, out)
+    finally:
+        done.close()
     write_file(out / "summary.json", json.dumps(result.summary, indent=1))
     files = [*result.files, out / "summary.json"]
     return dataclasses.replace(result, files=files), done

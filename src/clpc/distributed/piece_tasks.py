@@ -1,19 +1,26 @@
 """What a worker does with one piece of a long record (see :mod:`clpc.distributed.pieces`).
 
-Three tasks per piece, functions of picklable arguments:
+Two tasks per piece, functions of picklable arguments, both run in parallel:
 
-1. :func:`solve_piece` (parallel): read the piece's raw samples (from the file, or the slice
-   of a ``dask.array`` computed on a worker), check them as :meth:`clpc.CLPC.push` does,
-   decimate, and solve every window of the piece with the kernel's stateless solve
-   (:func:`clpc.appraiser.kernel.solve`); also each window's mean output level and the
-   channels' extremes (for the whole record's range check);
-2. :func:`fsm_piece` (sequential, cheap): the finite-state machine's output
-   (:func:`clpc.appraiser.kernel.output`) over the piece's windows in time order, starting
-   from the state the previous piece ended in; :func:`end_state` is that state (a few
-   numbers), all the next piece needs;
-3. :func:`finish_piece` (parallel): the piece's trace rows; or :func:`write_piece`: the rows
-   written to one file of a Parquet dataset, and only what a summary and a report need
-   returned.
+1. :func:`solve_piece`: read the piece's raw samples (from the file, or the slice of a
+   ``dask.array`` computed on a worker), check them as :meth:`clpc.CLPC.push` does,
+   decimate, solve every window with the kernel's stateless solve
+   (:func:`clpc.appraiser.kernel.solve`), and run the finite-state machine's output
+   (:func:`clpc.appraiser.kernel.output`) over them from "no model yet". That output is
+   already the record's from each equation's first accepted update of the piece on: an
+   accepted update replaces the whole carried state (the held theta, c and the has-a-model
+   flag), so nothing before it is seen after it. :func:`piece_info` is the few numbers the
+   client needs (:class:`PieceInfo`): the channels' extremes, the state the piece ends in
+   and which equations accepted an update in it;
+2. :func:`finish_piece` / :func:`write_piece`: given the state the record's FSM is in when
+   the piece starts (:func:`next_state` of the pieces before, computed on the client),
+   :func:`settle` runs the FSM again over the piece's first updates, up to each equation's
+   first accepted one (usually a handful), from that state; then the piece's trace rows are
+   returned, or written by the worker to one file of a Parquet dataset with only what a
+   summary and a report need returned.
+
+No task waits for another piece's task, and only the FSM state (a few numbers per output)
+goes from the client to a worker.
 """
 
 from __future__ import annotations
@@ -31,16 +38,18 @@ from clpc.appraiser.inputs import as_chunk
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
-from clpc.appraiser.tracefile import TraceWriter
+from clpc.distributed.part_file import write_part
 from clpc.distributed.pieces import Layout, Piece
 
 __all__ = [
+    "PieceInfo",
     "RecordPlan",
     "SolvedPiece",
     "WrittenPiece",
-    "end_state",
     "finish_piece",
-    "fsm_piece",
+    "next_state",
+    "piece_info",
+    "settle",
     "solve_piece",
     "trace_nbytes",
     "write_piece",
@@ -68,6 +77,9 @@ class RecordPlan:
         Window sizes, largest lag and decimation factor.
     n_raw : int
         Raw samples of the record.
+    levels : bool
+        Compute each window's mean output level (``meta["window_level"]`` of
+        :meth:`clpc.CLPC.run`); the summary of ``clpc track`` does not read it.
     """
 
     settings: Settings
@@ -76,6 +88,7 @@ class RecordPlan:
     record_dt: float | None
     layout: Layout
     n_raw: int
+    levels: bool = True
 
     def state(self) -> AppraiserState:
         """A fresh appraiser state of the record (channels known; owns the kernel setup)."""
@@ -98,22 +111,41 @@ def trace_nbytes(trace: Trace) -> int:
     return sum(a.nbytes for a in plain) + sum(a.nbytes for a in trace.arrays.values())
 
 
-try:  # Dask's memory accounting sizes a returned trace by its arrays
+class SolvedPiece(NamedTuple):
+    """The solved windows of a piece, batch by batch (:func:`clpc.appraiser.kernel.batches`).
+
+    ``outputs`` is the FSM output from "no model yet" until :func:`settle` makes the first
+    updates the record's (in place; settling again gives the same).
+    """
+
+    piece: Piece
+    batches: list[tuple[int, int]]
+    solved: list[kernel.Solved]
+    outputs: list[kernel.FsmOutput]
+    first_accepted: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
+    levels: np.ndarray | None  #: (count, n_out): each window's mean output (record samples)
+    peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
+
+
+try:  # Dask's memory accounting sizes a returned trace or solved piece by its arrays
     from dask.sizeof import sizeof
 except ImportError:  # pragma: no cover - the distributed extra is installed in the tests
     pass
 else:
     sizeof.register(Trace)(trace_nbytes)
 
+    @sizeof.register(SolvedPiece)
+    def _solved_nbytes(solved: SolvedPiece) -> int:
+        parts = [*solved.solved, *solved.outputs]
+        return sum(a.nbytes for part in parts for a in part)
 
-class SolvedPiece(NamedTuple):
-    """The solved windows of a piece, batch by batch (:func:`clpc.appraiser.kernel.batches`)."""
 
-    piece: Piece
-    batches: list[tuple[int, int]]
-    solved: list[kernel.Solved]
-    levels: np.ndarray  #: (count, n_out): each window's mean output (record samples)
-    peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
+class PieceInfo(NamedTuple):
+    """What the client learns of a solved piece (a few numbers)."""
+
+    peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum
+    end: FsmTuple  #: the FSM state after the piece, for the equations that accepted in it
+    accepted: np.ndarray  #: (E,) bool: the equation accepted an update in the piece
 
 
 def _kept(raw: np.ndarray, layout: Layout, piece: Piece) -> np.ndarray:
@@ -134,14 +166,22 @@ def _levels(y: np.ndarray, plan: RecordPlan, piece: Piece, rows: np.ndarray) -> 
     index = lay.max_lag + lay.cluster * np.arange(piece.j_lo, piece.j_hi + 1) - 1
     last = np.minimum(index * lay.factor, plan.n_raw - 1)
     first = np.minimum(np.maximum((index - rows + 1) * lay.factor, 0), last)
-    ref = y.mean(axis=0)
-    csum = np.vstack([np.zeros((1, y.shape[1])), np.cumsum(y - ref, axis=0)])
-    count = (last - first + 1)[:, None]
-    return (csum[last - lo + 1] - csum[first - lo]) / count + ref
+    out = np.empty((index.size, y.shape[1]))
+    for k in range(y.shape[1]):  # column by column: contiguous sums
+        col = np.ascontiguousarray(y[:, k])
+        ref = col.mean()
+        csum = np.concatenate([[0.0], np.cumsum(col - ref)])
+        out[:, k] = (csum[last - lo + 1] - csum[first - lo]) / (last - first + 1) + ref
+    return out
+
+
+def _peaks(columns: list[np.ndarray]) -> np.ndarray:
+    """(2, channels): each column's maximum and minimum."""
+    return np.array([[c.max() for c in columns], [c.min() for c in columns]])
 
 
 def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
-    """Read (or take), check and decimate a piece's samples; solve its windows.
+    """Read (or take), check and decimate a piece's samples; solve its windows; run the FSM.
 
     Parameters
     ----------
@@ -158,32 +198,66 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
     """
     if isinstance(raw, tuple):
         u, y = as_chunk(raw[0], raw[1], piece.raw[0])
-    else:
+        both = np.hstack([u, y])
+    else:  # float64 [inputs | outputs] as read: checked column by column, not copied
         both = raw.read(*piece.raw)
         n_in = plan.channels[0]
         u, y = as_chunk(both[:, :n_in], both[:, n_in:], piece.raw[0])
-    both = np.hstack([u, y])
     samples = _kept(both, plan.layout, piece)
     setup = plan.state().kernel_setup()
     first_row = piece.kept[0] - plan.layout.max_lag
     batches = kernel.batches(piece.j_lo, piece.j_hi, 1)
     solved = [kernel.solve(samples, first_row, b, setup) for b in batches]
+    state = kernel.FsmState(*plan.initial())
+    outputs = [kernel.output(s, setup, state) for s in solved]
+    accepted = np.concatenate([o.accepted for o in outputs])
+    first = np.where(accepted.any(axis=0), accepted.argmax(axis=0), -1)
     rows = np.concatenate([s.n_rows for s in solved])
-    peaks = np.stack([both.max(axis=0), both.min(axis=0)])
-    return SolvedPiece(piece, batches, solved, _levels(y, plan, piece, rows), peaks)
+    levels = _levels(y, plan, piece, rows) if plan.levels else None
+    peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
+    return SolvedPiece(piece, batches, solved, outputs, first, levels, peaks)
 
 
-def fsm_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> list[kernel.FsmOutput]:
-    """The FSM output over a piece's windows, from ``state`` (the previous piece's end)."""
+def piece_info(solved: SolvedPiece) -> PieceInfo:
+    """The extremes and the end state of a solved piece (see :func:`next_state`)."""
+    last = solved.outputs[-1]
+    end = (last.theta[-1].copy(), last.c[-1].copy(), last.has_model[-1].copy())
+    return PieceInfo(solved.peaks, end, solved.first_accepted >= 0)
+
+
+def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
+    """The record's FSM state after a piece that started in ``state``.
+
+    An equation that accepted an update in the piece ends in the piece's own end state;
+    one that did not holds what it held before the piece.
+    """
+    ok = info.accepted
+    theta = np.where(ok[:, None], info.end[0], state[0])
+    return theta, np.where(ok, info.end[1], state[1]), np.where(ok, info.end[2], state[2])
+
+
+def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> list[kernel.FsmOutput]:
+    """The piece's FSM output as the record's, given the state the record is in before it.
+
+    Runs the FSM from ``state`` over the updates before (and at) the last of the
+    equations' first accepted updates (every update when an equation accepted none); the
+    later updates' outputs do not depend on ``state``. Updates ``solved.outputs`` in place.
+    """
+    ends = np.where(solved.first_accepted >= 0, solved.first_accepted, solved.piece.updates - 1)
+    todo = int(ends.max()) + 1
     setup = plan.state().kernel_setup()
     carried = kernel.FsmState(*(np.array(a, copy=True) for a in state))
-    return [kernel.output(s, setup, carried) for s in solved.solved]
-
-
-def end_state(outputs: list[kernel.FsmOutput]) -> FsmTuple:
-    """The FSM state after a piece: the held output of its last update."""
-    last = outputs[-1]
-    return last.theta[-1].copy(), last.c[-1].copy(), last.has_model[-1].copy()
+    done = 0
+    for sol, out in zip(solved.solved, solved.outputs, strict=True):
+        n = min(out.theta.shape[0], todo - done)
+        if n <= 0:
+            break
+        head = kernel.Solved(*(a[:n] for a in sol))
+        again = kernel.output(head, setup, carried)
+        for have, want in zip(out, again, strict=True):
+            have[:n] = want
+        done += n
+    return solved.outputs
 
 
 def _arrays(sol: kernel.Solved, fsm: kernel.FsmOutput) -> dict[str, np.ndarray]:
@@ -196,10 +270,9 @@ def _arrays(sol: kernel.Solved, fsm: kernel.FsmOutput) -> dict[str, np.ndarray]:
     return arrays
 
 
-def piece_trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
-    """The trace rows of a piece (``meta["window_level"]``: its windows' levels)."""
-    st = plan.state()
-    labels = st.trace_labels()
+def _trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
+    """The trace rows of a piece (``meta["window_level"]``: its windows' levels, if any)."""
+    labels = plan.state().trace_labels()
     lay = plan.layout
     parts = []
     for (j0, count), sol, out in zip(solved.batches, solved.solved, outputs, strict=True):
@@ -207,13 +280,17 @@ def piece_trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: Reco
         index = lay.max_lag + lay.cluster * np.arange(j0, j0 + count) - 1
         parts.append(labels.trace(index, arrays.pop("n_rows"), arrays))
     trace = parts[0] if len(parts) == 1 else Trace.concat(parts)
-    trace.meta["window_level"] = solved.levels
+    if solved.levels is not None:
+        trace.meta["window_level"] = solved.levels
     return trace
 
 
-def finish_piece(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
-    """The piece's trace rows (what :meth:`clpc.CLPC.run` returns for these updates)."""
-    return piece_trace(solved, outputs, plan)
+def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
+    """The piece's trace rows (what :meth:`clpc.CLPC.run` returns for these updates).
+
+    ``state``: the record's FSM state before the piece (:func:`next_state`).
+    """
+    return _trace(solved, settle(solved, plan, state), plan)
 
 
 class WrittenPiece(NamedTuple):
@@ -226,8 +303,8 @@ class WrittenPiece(NamedTuple):
 
 def write_piece(
     solved: SolvedPiece,
-    outputs: list[kernel.FsmOutput],
     plan: RecordPlan,
+    state: FsmTuple,
     folder: str,
     keep: tuple[str, ...],
     thin: tuple[int, int],
@@ -236,8 +313,8 @@ def write_piece(
 
     Parameters
     ----------
-    solved, outputs, plan
-        The piece's solved windows, FSM output and record plan.
+    solved, plan, state
+        The piece's solved windows, the record plan and the FSM state before the piece.
     folder : str
         The dataset's folder (the file is named by the piece's number).
     keep : tuple of str
@@ -247,11 +324,8 @@ def write_piece(
         0`` (as :class:`clpc.appraiser.thinned.ThinnedTrace` keeps them); ``last`` updates
         are returned from the piece's end.
     """
-    trace = piece_trace(solved, outputs, plan)
-    path = Path(folder) / f"part-{solved.piece.number:06d}.parquet"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with TraceWriter(path) as writer:
-        writer.write(trace)
+    trace = finish_piece(solved, plan, state)
+    write_part(trace, Path(folder) / f"part-{solved.piece.number:06d}.parquet")
     stride, last = thin
     numbers = np.arange(solved.piece.j_lo - 1, solved.piece.j_hi)
     arrays = {k: v for k, v in trace.arrays.items() if k in keep}

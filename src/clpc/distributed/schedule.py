@@ -1,9 +1,12 @@
 """How a long record's pieces are given to a Dask cluster (see :mod:`.long_record`).
 
-:func:`run_pieces` submits each piece's solve, then - in time order, on the worker that
-holds the solved piece - its FSM pass (after the previous piece's), its finish and its
-channel extremes. At most :data:`AHEAD` pieces per worker are in flight, so a worker's memory
-is O(piece) whatever the record's length.
+:func:`run_pieces` submits each piece's solve (:func:`.piece_tasks.solve_piece`) and, as
+the solved pieces' few numbers arrive in time order (:func:`.piece_tasks.piece_info`), the
+record's FSM state at each piece's start (:func:`.piece_tasks.next_state`, on the client);
+then the piece's finish on the worker that holds it, with that state. No task waits for
+another piece's. At most :data:`AHEAD` pieces per worker are in flight, so a worker's
+memory is O(piece) whatever the record's length; what the finishes return is taken in time
+order.
 """
 
 from __future__ import annotations
@@ -17,10 +20,9 @@ import numpy as np
 from clpc.distributed.cluster import require_distributed
 from clpc.distributed.piece_tasks import (
     RecordPlan,
-    SolvedPiece,
-    end_state,
     finish_piece,
-    fsm_piece,
+    next_state,
+    piece_info,
     solve_piece,
 )
 from clpc.distributed.pieces import Piece
@@ -35,14 +37,16 @@ __all__ = [
     "run_pieces",
 ]
 
-#: most decimated samples per piece by default (about 1 s of one core's solving)
-PIECE_SAMPLES = 1 << 20
-#: pieces per worker the default piece size aims at (so that the workers stay busy)
-PIECES_PER_WORKER = 4
+#: most decimated samples per piece by default (about 1 s of one core's solving; a
+#: worker holds up to AHEAD of them: ~60 MB each with one input and one output)
+PIECE_SAMPLES = 1 << 21
+#: pieces per worker the default piece size aims at: a few, so that a worker slowed by
+#: another job is helped by the others at the end
+PIECES_PER_WORKER = 3
 #: fewest decimated samples per piece by default, in windows (the overlap read twice, at
 #: most ``W + max_lag``, stays below 2 % of a piece)
 MIN_PIECE_WINDOWS = 64
-#: pieces in flight per worker (solved, not yet finished)
+#: pieces in flight per worker (submitted, not yet taken by the client)
 AHEAD = 3
 
 
@@ -78,9 +82,8 @@ def run_pieces(
     piece_samples : int, optional
         Decimated samples per piece; default :func:`default_piece_samples`.
     finish : (callable, tuple)
-        ``(function, args)``: the last task of a piece, ``function(solved, outputs, plan,
+        ``(function, args)``: the last task of a piece, ``function(solved, plan, state,
         *args)`` (default :func:`.piece_tasks.finish_piece`: the piece's trace).
-
     sink : callable, optional
         Called with what ``finish`` returned for each piece, in time order, as it arrives
         (then not kept: ``parts`` is empty).
@@ -92,6 +95,7 @@ def run_pieces(
     peaks : ndarray, shape (2, channels)
         The maximum and the minimum of every raw channel of the record.
     """
+    distributed = require_distributed()
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     size = piece_samples or default_piece_samples(plan, n_workers)
     pieces = plan.layout.pieces(plan.n_raw, size)
@@ -101,8 +105,8 @@ def run_pieces(
     read = _reader(record)
     limit = AHEAD * n_workers
     state: Any = plan.initial()
-    solving: deque[tuple[Piece, Any]] = deque()
-    finishing: deque[tuple[Any, Any]] = deque()
+    solving: deque[tuple[Any, Any]] = deque()  # (solved, info) futures, in time order
+    finishing: deque[Any] = deque()
     results: list[Any] = []
     take = results.append if sink is None else sink
     peaks = np.array([[-np.inf], [np.inf]]) * np.ones(sum(plan.channels))
@@ -110,59 +114,51 @@ def run_pieces(
     while todo or solving or finishing:
         while todo and len(solving) + len(finishing) < limit:
             piece = todo.popleft()
-            raw = read(client, piece)
-            solving.append((piece, client.submit(solve_piece, raw, plan, piece, pure=False)))
-        if solving:  # the oldest solved piece: its FSM pass and rows where it lies
-            piece, solved = solving.popleft()
-            state, done, peak = _chain(client, (plan, solved), state, finish)
-            finishing.append((done, peak))
-        if finishing and (finishing[0][0].done() or not solving):
-            done, peak = finishing.popleft()
-            take(done.result())
-            part = peak.result()  # (2, channels): the piece's maxima and minima
-            peaks = np.stack([np.maximum(peaks[0], part[0]), np.minimum(peaks[1], part[1])])
+            solved = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
+            solving.append((solved, client.submit(piece_info, solved, pure=False)))
+        if solving and solving[0][1].done():
+            solved, info = solving.popleft()
+            part = info.result()  # raises the worker's error (e.g. a sample not finite)
+            finishing.append(_finish(client, solved, (plan, state), finish))
+            state = next_state(state, part)
+            peaks = np.stack([np.maximum(peaks[0], part.peaks[0]),
+                              np.minimum(peaks[1], part.peaks[1])])  # fmt: skip
+        elif finishing and finishing[0].done():
+            take(finishing.popleft().result())
+        else:
+            oldest = [solving[0][1]] if solving else []
+            oldest += [finishing[0]] if finishing else []
+            distributed.wait(oldest, return_when="FIRST_COMPLETED")
     return results, peaks
 
 
-def _chain(
+def _finish(
     client: Any,
+    solved: Any,
     job: tuple[RecordPlan, Any],
-    state: Any,
     finish: tuple[Callable[..., Any], tuple[Any, ...]],
-) -> tuple[Any, Any, Any]:
-    """Submit a solved piece's FSM pass (after the previous piece's), finish and peaks.
+) -> Any:
+    """Submit a solved piece's finish on the worker that holds it.
 
-    They run on the worker that holds the solved piece (a preference: another worker takes
-    them if that one is lost), so only the few numbers of the FSM state move between
-    workers. Returns the futures of the end state, the finish and the peaks.
+    A preference: another worker takes it if that one is lost. So only the FSM state moves
+    between processes.
     """
-    plan, solved = job
-    distributed = require_distributed()
-    distributed.wait(solved)
-    if solved.status == "error":
-        solved.result()  # raises the worker's error (e.g. a sample that is not finite)
+    plan, state = job
     where = list(client.who_has(solved).get(solved.key, ()))
     kw: dict[str, Any] = {"pure": False}
     if where:
         kw.update(workers=where, allow_other_workers=True)
-    outputs = client.submit(fsm_piece, solved, plan, state, **kw)
-    done = client.submit(finish[0], solved, outputs, plan, *finish[1], **kw)
-    return (
-        client.submit(end_state, outputs, **kw),
-        done,
-        client.submit(_peaks, solved, **kw),
-    )
+    return client.submit(finish[0], solved, plan, state, *finish[1], **kw)
 
 
 def default_piece_samples(plan: RecordPlan, n_workers: int) -> int:
     """Decimated samples per piece by default.
 
-    :data:`PIECES_PER_WORKER` pieces per worker, at most :data:`PIECE_SAMPLES` samples, at
-    least :data:`MIN_PIECE_WINDOWS` windows.
+    :data:`PIECES_PER_WORKER` pieces per worker (or more, of at most :data:`PIECE_SAMPLES`
+    samples), of equal numbers of updates; at least :data:`MIN_PIECE_WINDOWS` windows.
     """
-    share = plan.layout.kept(plan.n_raw) // (PIECES_PER_WORKER * n_workers)
-    return max(min(share, PIECE_SAMPLES), MIN_PIECE_WINDOWS * plan.layout.window)
-
-
-def _peaks(solved: SolvedPiece) -> np.ndarray:
-    return solved.peaks
+    lay = plan.layout
+    updates = lay.updates(plan.n_raw)
+    count = max(PIECES_PER_WORKER * n_workers, -(-updates * lay.cluster // PIECE_SAMPLES))
+    per = -(-updates // count)
+    return max(per * lay.cluster, MIN_PIECE_WINDOWS * lay.window)
