@@ -39,7 +39,8 @@ from clpc.core.atomic import write_file
 from clpc.data import DataError
 from clpc.distributed.cluster import dask_client
 from clpc.distributed.long_record import check_peaks, gather, plan_record
-from clpc.distributed.piece_tasks import RecordPlan, WrittenPiece, write_piece
+from clpc.distributed.part_file import WrittenPiece, write_piece
+from clpc.distributed.piece_tasks import RecordPlan
 from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
 from clpc.distributed.sources import NpySource, ParquetSource, open_source

@@ -25,9 +25,7 @@ goes from the client to a worker.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -38,21 +36,18 @@ from clpc.appraiser.inputs import as_chunk
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
-from clpc.distributed.part_file import write_part
 from clpc.distributed.pieces import Layout, Piece
 
 __all__ = [
     "PieceInfo",
     "RecordPlan",
     "SolvedPiece",
-    "WrittenPiece",
     "finish_piece",
     "next_state",
     "piece_info",
     "settle",
     "solve_piece",
     "trace_nbytes",
-    "write_piece",
 ]
 
 #: the carried FSM state: last accepted theta (E, p), its c (E,), has-a-model flags (E,)
@@ -291,46 +286,3 @@ def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trac
     ``state``: the record's FSM state before the piece (:func:`next_state`).
     """
     return _trace(solved, settle(solved, plan, state), plan)
-
-
-class WrittenPiece(NamedTuple):
-    """What a worker sends back of a piece whose rows it wrote (small)."""
-
-    summary: Trace  #: every update, the arrays a summary reads only
-    figures: Trace  #: every ``stride``-th update of the record (all arrays)
-    last: Trace  #: the piece's last updates (all arrays)
-
-
-def write_piece(
-    solved: SolvedPiece,
-    plan: RecordPlan,
-    state: FsmTuple,
-    folder: str,
-    keep: tuple[str, ...],
-    thin: tuple[int, int],
-) -> WrittenPiece:
-    """Write the piece's rows to ``folder/part-NNNNNN.parquet``; return what a report needs.
-
-    Parameters
-    ----------
-    solved, plan, state
-        The piece's solved windows, the record plan and the FSM state before the piece.
-    folder : str
-        The dataset's folder (the file is named by the piece's number).
-    keep : tuple of str
-        The per-update arrays of :attr:`WrittenPiece.summary`.
-    thin : (int, int)
-        ``(stride, last)``: the figures take the updates ``j`` with ``(j - 1) % stride ==
-        0`` (as :class:`clpc.appraiser.thinned.ThinnedTrace` keeps them); ``last`` updates
-        are returned from the piece's end.
-    """
-    trace = finish_piece(solved, plan, state)
-    write_part(trace, Path(folder) / f"part-{solved.piece.number:06d}.parquet")
-    stride, last = thin
-    numbers = np.arange(solved.piece.j_lo - 1, solved.piece.j_hi)
-    arrays = {k: v for k, v in trace.arrays.items() if k in keep}
-    return WrittenPiece(
-        dataclasses.replace(trace, arrays=arrays),
-        trace.take(np.flatnonzero(numbers % stride == 0)),
-        trace.take(np.arange(max(len(trace) - last, 0), len(trace))),
-    )
