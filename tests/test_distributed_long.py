@@ -317,3 +317,51 @@ def test_the_long_summary_is_clpc_tracks_bit_for_bit(client, tmp_path):
     # the summary JSON of clpc track (the advice aside: made from the report's data)
     want = {k: v for k, v in plain.summary.items() if k != "advice"}
     assert json.dumps(done.summary, indent=1) == json.dumps(want, indent=1)
+
+
+def test_a_worker_killed_mid_record_leaves_the_trace_bit_for_bit(tmp_path):
+    """SIGKILL a worker while it solves a piece: Dask reruns its pieces, the trace is equal."""
+    import os
+    import signal as signals
+    import threading
+    import time
+
+    import distributed
+
+    u, y = _record(400_000)
+    ref = CLPC().run(u, y)
+    killed: dict = {}
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        client.wait_for_workers(2)
+        pids = client.run(os.getpid)  # worker address -> its process id
+
+        def kill_a_busy_worker() -> None:
+            deadline = time.monotonic() + 60
+            while not killed and time.monotonic() < deadline:
+                busy = [
+                    a
+                    for a, keys in client.processing().items()
+                    if a in pids and any("solve" in str(k) for k in keys)
+                ]
+                if busy:
+                    os.kill(pids[busy[0]], signals.SIGKILL)
+                    killed.update(pid=pids[busy[0]])
+                time.sleep(0.01)
+
+        killer = threading.Thread(target=kill_a_busy_worker)
+        killer.start()
+        got = run_long(
+            CLPC(),
+            da.from_array(u, chunks=50_000),
+            da.from_array(y, chunks=50_000),
+            client=client,
+            piece_samples=20_000,
+        )
+        killer.join()
+    assert killed, "no worker was solving a piece"
+    _assert_same(ref, got)
