@@ -139,15 +139,11 @@ class Trace:
         if not traces:
             raise ValueError("nothing to concatenate")
         first = traces[0] if like is None else like
-        plain = ("index", "time", "rows", "not_enough_data")
-        kw: dict[str, Any] = {f: np.concatenate([getattr(t, f) for t in traces]) for f in plain}
-        arrays = {k: np.concatenate([t.arrays[k] for t in traces]) for k in first.arrays}
-        rest = {
-            f.name: getattr(first, f.name)
-            for f in fields(cls)
-            if f.name not in plain and f.name != "arrays"
+        kw: dict[str, Any] = {
+            f: np.concatenate([getattr(t, f) for t in traces]) for f in _ROW_FIELDS
         }
-        return cls(**kw, arrays=arrays, **rest)
+        arrays = {k: np.concatenate([t.arrays[k] for t in traces]) for k in first.arrays}
+        return replace(first, **kw, arrays=arrays)
 
     @classmethod
     def allocate(cls, like: Trace, n: int) -> Trace:
@@ -163,17 +159,12 @@ class Trace:
         n : int
             Rows to allocate.
         """
-        plain = ("index", "time", "rows", "not_enough_data")
         kw: dict[str, Any] = {
-            f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in plain
+            f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype)
+            for f in _ROW_FIELDS
         }
         arrays = {k: np.empty((n, *v.shape[1:]), v.dtype) for k, v in like.arrays.items()}
-        rest = {
-            f.name: getattr(like, f.name)
-            for f in fields(cls)
-            if f.name not in plain and f.name not in ("arrays", "meta")
-        }
-        return cls(**kw, arrays=arrays, meta=dict(like.meta), **rest)
+        return replace(like, **kw, arrays=arrays, meta=dict(like.meta))
 
     def view(self, start: int, stop: int) -> Trace:
         """Rows ``start .. stop - 1`` sharing this trace's memory (writing one writes both).
@@ -184,7 +175,7 @@ class Trace:
             The rows, as in a slice.
         """
         rows = slice(start, stop)
-        values = {f: getattr(self, f)[rows] for f in ("index", "time", "rows", "not_enough_data")}
+        values = {f: getattr(self, f)[rows] for f in _ROW_FIELDS}
         values["arrays"] = {k: v[rows] for k, v in self.arrays.items()}
         for f in _FIELD_NAMES - values.keys():
             values[f] = getattr(self, f)
@@ -206,7 +197,7 @@ class Trace:
             ``start + len(part)``.
         """
         stop = start + len(part)
-        for f in ("index", "time", "rows", "not_enough_data"):
+        for f in _ROW_FIELDS:
             getattr(self, f)[start:stop] = getattr(part, f)
         for key, value in self.arrays.items():
             value[start:stop] = part.arrays[key]
@@ -238,15 +229,8 @@ class Trace:
         levels = meta.get("window_level")
         if levels is not None and np.shape(levels)[0] == len(self):
             meta["window_level"] = np.asarray(levels)[rows]
-        return replace(
-            self,
-            index=self.index[rows],
-            time=self.time[rows],
-            rows=self.rows[rows],
-            not_enough_data=self.not_enough_data[rows],
-            arrays={k: v[rows] for k, v in self.arrays.items()},
-            meta=meta,
-        )
+        kw: dict[str, Any] = {f: getattr(self, f)[rows] for f in _ROW_FIELDS}
+        return replace(self, **kw, arrays={k: v[rows] for k, v in self.arrays.items()}, meta=meta)
 
     def held(self, n_samples: int) -> np.ndarray:
         """Held output parameters at every sample ``k = 0 .. n_samples - 1``.
@@ -275,10 +259,8 @@ class Trace:
     ) -> Convergence:
         """First update after which ``theta`` and ``D`` stay quasi-constant.
 
-        An update is quasi-constant when every equation's accepted ``theta`` moved by less
-        than ``theta_tol`` (Euclidean, unit vectors) and ``D`` by less than ``D_tol``
-        (relative) since the previous update; convergence needs ``consecutive`` such
-        updates in a row, and at least :data:`MIN_TRUSTED_FRACTION` of the windows trusted
+        ``consecutive`` updates in a row within the tolerances below, and at least
+        :data:`MIN_TRUSTED_FRACTION` of the windows trusted
         (:func:`clpc.appraiser.convergence.convergence`).
 
         Parameters
@@ -313,3 +295,5 @@ class Trace:
 
 
 _FIELD_NAMES = {f.name for f in fields(Trace)}
+#: the fields with one row per update besides ``arrays``
+_ROW_FIELDS = ("index", "time", "rows", "not_enough_data")
