@@ -233,3 +233,16 @@ def test_readers_take_a_dropped_sample_with_one_warning_line(tmp_path):
     warned = [line for line in res.stderr.splitlines() if line.startswith("warning:")]
     assert len(warned) == 1 and "2 sample(s) missing before line 1002" in warned[0]
     assert "UserWarning" not in res.stderr and "warnings.warn" not in res.stderr
+
+
+def test_the_stream_and_the_readers_classify_a_step_alike():
+    """One rule written twice (array and scalar forms): they must agree, at any tolerance."""
+    from clpc.data.time_gaps import classify_steps, whole_steps
+
+    rng = np.random.default_rng(5)
+    steps = np.concatenate([rng.uniform(0.0, 4.0, 20_000), np.arange(1, 1003) * 1.003, [np.inf]])
+    for rtol in (1e-3, 1e-2, 0.3, 0.6):
+        single, missing = classify_steps(steps, 1.0, rtol)
+        want = np.where(single, 1, np.where(missing > 0, missing + 1, 0))
+        got = np.array([whole_steps(float(s), 1.0, rtol) for s in steps])
+        np.testing.assert_array_equal(got, want)

@@ -13,12 +13,13 @@ says.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["MAX_GAP_SAMPLES", "classify_steps", "gap_note", "warn_gaps"]
+__all__ = ["MAX_GAP_SAMPLES", "classify_steps", "gap_note", "warn_gaps", "whole_steps"]
 
 #: Longest gap taken at once [sample times]; a longer step is refused by a file reader, and
 #: after it a stream's next sample must confirm the new grid (a stamp far ahead is more often
@@ -57,6 +58,26 @@ def classify_steps(steps: np.ndarray, typical: float, rtol: float) -> tuple[np.n
             & (np.abs(ratio - whole) <= rtol * whole)
         )
     return single, np.where(gap, whole - 1, 0).astype(np.int64)
+
+
+def whole_steps(step: float, typical: float, rtol: float) -> int:
+    """:func:`classify_steps` for one step, in plain floats (a stream's per-sample path).
+
+    Parameters
+    ----------
+    step, typical, rtol
+        As :func:`classify_steps` (one step [s]).
+
+    Returns
+    -------
+    int
+        1 for one sample time, ``m`` for a gap of ``m`` sample times, 0 for neither.
+    """
+    ratio = step / typical
+    if abs(ratio - 1.0) <= rtol:
+        return 1
+    whole = round(ratio) if math.isfinite(ratio) else 0
+    return whole if 2 <= whole <= MAX_GAP_SAMPLES and abs(ratio - whole) <= rtol * whole else 0
 
 
 def gap_note(name: str, gaps: list[tuple[int, int]], label: Callable[[int], str], dt: float) -> str:

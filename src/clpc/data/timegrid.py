@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from clpc.data.time_gaps import MAX_GAP_SAMPLES
+from clpc.data.time_gaps import MAX_GAP_SAMPLES, whole_steps
 from clpc.data.time_units import TIME_UNITS, time_unit
 from clpc.data.timebase import (
     DEFAULT_TIME_RTOL,
@@ -135,8 +135,8 @@ class TimeGrid:
         assert self.dt is not None
         step = self._mean_step()
         m = (t - self._last) / step
-        whole = round(m)
-        if 1 <= whole <= MAX_GAP_SAMPLES and step_deviation(m, whole) <= self.rtol:
+        whole = whole_steps(t - self._last, step, self.rtol)  # the readers' rule
+        if whole:  # one sample time, or dropped samples
             drift = abs(t - (self._anchor + (self._since + whole) * step)) / step
             prev, self._odd = self._last, None
             if whole == 1 and drift <= MAX_DRIFT_SAMPLES:
