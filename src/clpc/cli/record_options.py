@@ -107,7 +107,8 @@ def sampling_options() -> Decorator:
             "time_col",
             metavar="COL",
             default=None,
-            help="Column of sample times; dt is its mean step (steps uniform within --time-rtol).",
+            help="Column of sample times; dt is its mean step (steps within --time-rtol; a "
+            "gap of whole sample times is reported and the grid re-anchored).",
         ),
         time_base_options(),
         click.option(
