@@ -1,12 +1,10 @@
 """CLPC: the paper's appraiser (section V), a finite-state machine over time windows.
 
-The semantics - samples and lag vectors, windows that grow then slide, an update every
-``cluster_size`` lag vectors, accept-or-hold, the guard, decimation - are in ``docs/clpc.md``.
-The settings are :class:`clpc.appraiser.settings.Settings` (checked, read-only; each one a
-property, :class:`~clpc.appraiser.settings.SettingsProperties`); the FSM state and its
-transition :class:`clpc.appraiser.state.AppraiserState`, one per record, fed by
-:mod:`clpc.appraiser.feeding` and saved by :mod:`clpc.appraiser.saved_state`; records that are
-not arrays in memory go to the runners of :mod:`clpc.appraiser.runners`.
+Semantics (lag vectors, growing then sliding windows, accept-or-hold, guard, decimation):
+``docs/clpc.md``. Settings: :class:`clpc.appraiser.settings.Settings` (read-only). The FSM
+state: :class:`clpc.appraiser.state.AppraiserState`, one per record, fed by
+:mod:`clpc.appraiser.feeding`, saved by :mod:`clpc.appraiser.saved_state`; records not in
+memory go to the runners of :mod:`clpc.appraiser.runners`.
 """
 
 from __future__ import annotations

@@ -68,6 +68,10 @@ class Table:
         The values; stored as a float64 array of shape (n_rows, n_columns).
     source : str, optional
         Where the values came from (a file name), used in error messages.
+    lines : ndarray of int64, shape (n_rows,), optional
+        1-based file line of each row (text files): rows are then labelled by line. Stored
+        as the first line when the rows are contiguous. None: rows are labelled
+        ``row 1, row 2, ...``.
 
     Attributes
     ----------
@@ -81,7 +85,13 @@ class Table:
 
     __slots__ = ("_first", "_lines", "_unit", "data", "names", "source")
 
-    def __init__(self, names: Sequence[str], data: Any, source: str = "") -> None:
+    def __init__(
+        self,
+        names: Sequence[str],
+        data: Any,
+        source: str = "",
+        lines: np.ndarray | None = None,
+    ) -> None:
         listed, arr = named_columns(names, data, ("Table data must be 1-D or 2-D", "Table needs"))
         self.names: list[str] = listed
         self.data: np.ndarray = arr
@@ -89,6 +99,12 @@ class Table:
         self._first = 1  # label number of row 0 when _lines is None
         self._lines: np.ndarray | None = None  # 1-based file line of each row (text files)
         self._unit = "row"
+        if lines is not None:
+            self._unit = "line"
+            if lines.size == 0 or int(lines[-1]) - int(lines[0]) == lines.size - 1:
+                self._first = int(lines[0]) if lines.size else 1
+            else:
+                self._lines = lines
 
     @property
     def n_rows(self) -> int:
@@ -179,14 +195,7 @@ def located_table(
     Table
         The table; its :meth:`Table.row_label` names lines or rows.
     """
-    table = Table(names, data, source)
-    if lines is not None:
-        table._unit = "line"
-        if lines.size == 0 or int(lines[-1]) - int(lines[0]) == lines.size - 1:
-            table._first = int(lines[0]) if lines.size else 1
-        else:
-            table._lines = lines
-    return table
+    return Table(names, data, source, lines)
 
 
 def _list_names(names: Sequence[str], limit: int = 25) -> str:

@@ -6,11 +6,29 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ModelError", "as_2d"]
+__all__ = ["ModelError", "as_2d", "require_siso"]
 
 
 class ModelError(ValueError):
     """The requested operation does not exist for this model (e.g. an unstable inverse)."""
+
+
+def require_siso(model: Any, what: str) -> None:
+    """Raise :class:`ModelError` unless ``model`` has one input and one output.
+
+    Parameters
+    ----------
+    model : LinearModel
+        The model asked for ``what``.
+    what : str
+        The method or property asked for, named in the message.
+    """
+    if not model.is_siso:
+        raise ModelError(
+            f"{what} is defined for single-input single-output models; this model has "
+            f"{model.n_inputs} input(s) and {model.n_outputs} output(s). "
+            "Use numerators/denominators or to_control()."
+        )
 
 
 def as_2d(x: Any, n_cols: int, name: str) -> tuple[np.ndarray, bool]:

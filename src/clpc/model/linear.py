@@ -29,7 +29,7 @@ import numpy as np
 from clpc.core.filters import frequency_response
 from clpc.core.polynomials import monic, pole_class
 from clpc.model import display
-from clpc.model.errors import ModelError
+from clpc.model.errors import ModelError, require_siso
 from clpc.model.evidence import FitInfo, FitRecord
 from clpc.model.export import Exports
 from clpc.model.structure import Structure
@@ -171,24 +171,16 @@ class LinearModel(TimeDomain, UncertaintyMethods, Exports):
         """Constant term ``c/a0`` of the monic equation, shape (n_outputs,)."""
         return self.c / self._a0()
 
-    def _siso(self, what: str) -> None:
-        if not self.is_siso:
-            raise ModelError(
-                f"{what} is defined for single-input single-output models; this model has "
-                f"{self.n_inputs} input(s) and {self.n_outputs} output(s). "
-                "Use numerators/denominators or to_control()."
-            )
-
     @property
     def num(self) -> np.ndarray:
         """SISO numerator ``-B(z)/a0``, ascending powers of ``z^-1``, shape (nk+nb+1,)."""
-        self._siso("num")
+        require_siso(self, "num")
         return self.numerators[0, 0]
 
     @property
     def den(self) -> np.ndarray:
         """SISO monic denominator ``A(z)/a0``, ascending powers of ``z^-1``, shape (na+1,)."""
-        self._siso("den")
+        require_siso(self, "den")
         return self.denominators[0]
 
     def poles(self, output: int = 0) -> np.ndarray:

@@ -14,7 +14,7 @@ import numpy as np
 from clpc.core.filters import all_pole, fir
 from clpc.data import DataError, IOData
 from clpc.data.signals import signals
-from clpc.model.errors import ModelError, as_2d
+from clpc.model.errors import ModelError, as_2d, require_siso
 
 __all__ = ["NOISE_MODELS", "forced", "infer_input", "noise_models", "predict", "simulate"]
 
@@ -220,7 +220,7 @@ def infer_input(
     model: Any, y: Any, *, y_init: Any | None = None, allow_unstable: bool = False
 ) -> np.ndarray:
     """The input that explains a measured output (:meth:`clpc.LinearModel.infer_input`)."""
-    model._siso("infer_input")
+    require_siso(model, "infer_input")
     if isinstance(y, IOData):
         y = signals(y, what="infer_input")[1]
     y2, _ = as_2d(y, 1, "y")

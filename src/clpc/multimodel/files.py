@@ -8,12 +8,37 @@ from __future__ import annotations
 from typing import Any, Self
 
 from clpc.multimodel import store
+from clpc.multimodel.fitting import Fitted
 
 __all__ = ["ModelFiles"]
 
 
 class ModelFiles:
     """``to_dict``, ``from_dict``, ``save`` and ``load`` of a multi-model."""
+
+    _fitted: Fitted | None
+    n_inputs: int
+    dt: float
+
+    def install_fit(self, fitted: Fitted, n_inputs: int, dt: float) -> Self:
+        """Take a fit made elsewhere (a file read by :func:`clpc.multimodel.store.from_dict`).
+
+        Parameters
+        ----------
+        fitted : Fitted
+            Local models, centres, widths and diagnostics, already checked.
+        n_inputs : int
+            Inputs of the local models.
+        dt : float
+            Sample time [s].
+
+        Returns
+        -------
+        MultiModel
+            ``self``, fitted.
+        """
+        self.n_inputs, self.dt, self._fitted = int(n_inputs), float(dt), fitted
+        return self
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe description (floats exact); see :mod:`clpc.multimodel.store`."""

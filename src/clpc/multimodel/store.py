@@ -28,7 +28,7 @@ VERSION = 1
 
 def to_dict(mm: Any) -> dict[str, Any]:
     """The fitted multi-model as a JSON-safe dict."""
-    f = mm._require()
+    models, centres, widths = mm.local_models, mm.centres, mm.widths
     if callable(mm.schedule_spec):
         raise ValueError(
             "a multi-model scheduled on a Python callable cannot be saved to JSON; use "
@@ -43,8 +43,8 @@ def to_dict(mm: Any) -> dict[str, Any]:
         "dt": mm.dt,
         "schedule": mm.schedule_spec,
         "settings": dict(mm.settings),
-        "centres": [float(c) for c in f.centres],
-        "widths": [None if not math.isfinite(w) else float(w) for w in f.widths],
+        "centres": [float(c) for c in centres],
+        "widths": [None if not math.isfinite(w) else float(w) for w in widths],
         "local_models": [
             {
                 "theta": [float(v) for v in np.atleast_2d(m.theta)[0]],
@@ -53,9 +53,9 @@ def to_dict(mm: Any) -> dict[str, Any]:
                 "replaced": bool(m.info.get("replaced", False)),
                 "weight": float(m.info.get("weight", 0.0)),
             }
-            for m in f.local_models
+            for m in models
         ],
-        "diagnostics": jsonable(f.diagnostics),
+        "diagnostics": jsonable(mm.diagnostics),
     }
 
 
@@ -129,8 +129,8 @@ def from_dict(cls: Any, data: dict[str, Any]) -> Any:
     centres = _finite(_field(data, "centres"), "centres")
     if not (centres.ndim == 1 and centres.size == widths.size == len(models) >= 1):
         raise ValueError("centres, widths and local_models must have the same (nonzero) length.")
-    mm._fitted = Fitted(models, centres, widths, dict(data.get("diagnostics") or {}))
-    return mm
+    fitted = Fitted(models, centres, widths, dict(data.get("diagnostics") or {}))
+    return mm.install_fit(fitted, mm.n_inputs, mm.dt)
 
 
 def save(mm: Any, path: Any) -> None:
