@@ -226,13 +226,16 @@ def solve_one(
             if not math.isfinite(scat[a, b]):
                 finite = False
     channel_scales(scat, n_rows, plan.col_channel, s.n_channels, scales)
-    solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
-    ok = finite and sym_eig(mat, vals, vecs, ework, True)
-    if ok and s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself
-        for a in range(p):
-            raw[a] = vals[a]
-    elif ok:
-        ok = sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
+    if s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself (T = I, unused)
+        ok = finite and sym_eig(scat, vals, vecs, ework, True)
+        if ok:
+            for a in range(p):
+                raw[a] = vals[a]
+    else:
+        solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
+        ok = finite and sym_eig(mat, vals, vecs, ework, True)
+        if ok:
+            ok = sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
     if not ok:
         for a in range(p):
             theta[a] = 0.0
