@@ -50,7 +50,6 @@ from clpc.appraiser.blocks import (
     new_cache,
     piece_stats,
     piece_step,
-    tail_split,
 )
 from clpc.core.polynomials import monic, schur_stable
 from clpc.core.rules import (
@@ -275,16 +274,12 @@ def solve_windows(
     j0, count = windows
     n_eq, p = plan.chan.shape
     window, cluster, size = plan.window, plan.cluster, plan.block
-    split = tail_split(window, cluster, size)
     first = -first_row
     b_lo = -(-max(0, cluster * j0 - window) // size)  # the first full block of any window
     n_blocks = max(0, cluster * (j0 + count - 1) // size - b_lo)
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
     b_step = np.empty(n_blocks)
-    s_mean = np.empty((n_blocks + 1, p))  # block suffixes (tails) when split > 0
-    s_scat = np.empty((n_blocks + 1, p, p))
-    s_step = np.empty(n_blocks + 1)
     t_mean = np.empty(p)
     t_scat = np.empty((p, p))
     h_mean = np.empty(p)
@@ -300,19 +295,10 @@ def solve_windows(
         lag = plan.lag[eq]
         gather_blocks(
             samples,
-            (chan, lag, first, b_lo, n_blocks, size, split),
-            (
-                cache.mean[eq],
-                cache.scat[eq],
-                cache.step[eq],
-                cache.tail_mean[eq],
-                cache.tail_scat[eq],
-                cache.tail_step[eq],
-                c_lo,
-                c_hi,
-            ),
-            (z, dev, t_mean, t_scat),
-            (b_mean, b_scat, b_step, s_mean, s_scat, s_step),
+            (chan, lag, first, b_lo, n_blocks, size),
+            (cache.mean[eq], cache.scat[eq], cache.step[eq], c_lo, c_hi),
+            z,
+            (b_mean, b_scat, b_step),
         )
         for w in range(count):
             j = j0 + w
@@ -339,23 +325,18 @@ def solve_windows(
             h_start = min(max(full_hi * size, t_end), e)
             t_size = t_end - start
             h_size = e - h_start
-            # the output's quantization step in the window (column 0 is y(n))
-            if split > 0 and t_size > 0:  # the tail is the suffix of block full_lo - 1
-                tail = full_lo - b_lo
-                tail_mean, tail_scat, step = s_mean[tail], s_scat[tail], s_step[tail]
-            else:
-                tail_mean, tail_scat = t_mean, t_scat
-                if t_size > 0:
-                    piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
-                step = piece_step(samples, chan[0], first, (start, t_end))
+            if t_size > 0:
+                piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
             if h_size > 0:
                 piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
+            # the output's quantization step in the window (column 0 is y(n))
+            step = piece_step(samples, chan[0], first, (start, t_end))
             step = min(step, piece_step(samples, chan[0], first, (h_start, e)))
             for b in range(full_lo - b_lo, full_hi - b_lo):
                 step = min(step, b_step[b])
             n_w = merge(
                 (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
-                (t_size, tail_mean, tail_scat, h_size, h_mean, h_scat),
+                (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
                 dev,
                 (mean, scat),
             )
