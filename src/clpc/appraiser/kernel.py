@@ -287,7 +287,7 @@ def solve_windows(
     dev = np.empty((window // size + 3, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
-    z = np.empty(p)
+    z = np.empty((size, p))  # the rows of one piece
     work = new_work(p)
     c_lo, c_hi = cache.span[0], cache.span[1]
     for eq in range(n_eq):
