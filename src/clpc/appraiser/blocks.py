@@ -106,57 +106,36 @@ def merge(
     t_size, t_mean, t_scat, h_size, h_mean, h_scat = pieces
     mean, scat = out
     p = mean.shape[0]
-    pp = p * p
     total = t_size + size * (hi - lo) + h_size
-    # each sum runs over the pieces in row order (tail, blocks, head), piece by piece, over
-    # whole rows of the (C-contiguous) arrays, so that the inner loops vectorise
     for a in range(p):
-        mean[a] = t_size * t_mean[a] if t_size > 0 else 0.0
-    for k in range(lo, hi):
-        for a in range(p):
-            mean[a] += size * b_mean[k, a]
-    if h_size > 0:
-        for a in range(p):
-            mean[a] += h_size * h_mean[a]
-    for a in range(p):
-        mean[a] = mean[a] / total
+        acc = t_size * t_mean[a] if t_size > 0 else 0.0
+        for k in range(lo, hi):
+            acc += size * b_mean[k, a]
+        if h_size > 0:
+            acc += h_size * h_mean[a]
+        mean[a] = acc / total
     root = math.sqrt(size)
-    n_dev = 0
-    if t_size > 0:
-        t_root = math.sqrt(t_size)
-        for a in range(p):
-            dev[n_dev, a] = t_root * (t_mean[a] - mean[a])
-        n_dev += 1
-    for k in range(lo, hi):
-        for a in range(p):
-            dev[n_dev, a] = root * (b_mean[k, a] - mean[a])
-        n_dev += 1
+    t_root = math.sqrt(t_size)
+    n_dev = hi - lo + 1
+    for a in range(p):
+        dev[0, a] = t_root * (t_mean[a] - mean[a]) if t_size > 0 else 0.0
+        for k in range(lo, hi):
+            dev[k - lo + 1, a] = root * (b_mean[k, a] - mean[a])
+        if h_size > 0:
+            dev[n_dev, a] = math.sqrt(h_size) * (h_mean[a] - mean[a])
     if h_size > 0:
-        h_root = math.sqrt(h_size)
-        for a in range(p):
-            dev[n_dev, a] = h_root * (h_mean[a] - mean[a])
         n_dev += 1
-    flat = scat.reshape(pp)
-    if t_size > 0:
-        t_flat = t_scat.reshape(pp)
-        for i in range(pp):
-            flat[i] = t_flat[i]
-    else:
-        for i in range(pp):
-            flat[i] = 0.0
-    b_flat = b_scat.reshape((b_scat.shape[0], pp))
-    for k in range(lo, hi):
-        for i in range(pp):
-            flat[i] += b_flat[k, i]
-    if h_size > 0:
-        h_flat = h_scat.reshape(pp)
-        for i in range(pp):
-            flat[i] += h_flat[i]
-    for k in range(n_dev):  # + sum n_k (mean_k - mean)(mean_k - mean)^T
-        for a in range(p):
-            d_a = dev[k, a]
-            for b in range(p):
-                scat[a, b] += d_a * dev[k, b]
+    for a in range(p):
+        for b in range(a + 1):
+            acc = t_scat[a, b] if t_size > 0 else 0.0
+            for k in range(lo, hi):
+                acc += b_scat[k, a, b]
+            if h_size > 0:
+                acc += h_scat[a, b]
+            for k in range(n_dev):
+                acc += dev[k, a] * dev[k, b]
+            scat[a, b] = acc
+            scat[b, a] = acc
     return float(total)
 
 
