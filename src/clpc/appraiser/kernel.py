@@ -43,6 +43,14 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numba
 import numpy as np
 
+from clpc.appraiser.blocks import (
+    BlockCache,
+    gather_blocks,
+    merge,
+    new_cache,
+    piece_stats,
+    piece_step,
+)
 from clpc.core.polynomials import monic, schur_stable
 from clpc.core.rules import (
     NO_TRANSFORM,
@@ -194,113 +202,6 @@ def new_work(p: int) -> Work:
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def piece_stats(
-    samples: np.ndarray,
-    chan: np.ndarray,
-    lag: np.ndarray,
-    first: int,
-    rows: tuple[int, int],
-    z: np.ndarray,
-    out: tuple[np.ndarray, np.ndarray],
-) -> None:
-    """Mean and centered scatter (two-pass) of lag rows ``rows[0] .. rows[1] - 1``.
-
-    Row ``r`` is the lag vector whose newest sample is ``samples[first + r]``, built on the
-    fly into ``z``; ``out = (mean (p,), scat (p, p))``.
-    """
-    lo, hi = rows
-    mean, scat = out
-    p = mean.shape[0]
-    n = hi - lo
-    for a in range(p):
-        mean[a] = 0.0
-        for b in range(a + 1):
-            scat[a, b] = 0.0
-    for r in range(lo, hi):
-        for a in range(p):
-            mean[a] += samples[first + r - lag[a], chan[a]]
-    for a in range(p):
-        mean[a] /= n
-    for r in range(lo, hi):
-        for a in range(p):
-            z[a] = samples[first + r - lag[a], chan[a]] - mean[a]
-        for a in range(p):
-            for b in range(a + 1):
-                scat[a, b] += z[a] * z[b]
-    for a in range(p):
-        for b in range(a):
-            scat[b, a] = scat[a, b]
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, int]) -> float:
-    """The smallest nonzero change of one channel over the newest samples of rows ``rows``.
-
-    Its quantization step as far as the piece shows (``inf`` when it does not change):
-    row ``r``'s newest sample ``samples[first + r]`` against the one before it.
-    """
-    lo, hi = rows
-    best = math.inf
-    for r in range(lo, hi):
-        d = abs(samples[first + r, channel] - samples[first + r - 1, channel])
-        if d > 0 and d < best:
-            best = d
-    return best
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def merge(
-    blocks: tuple[np.ndarray, np.ndarray, int, int, int],
-    pieces: tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray],
-    dev: np.ndarray,
-    out: tuple[np.ndarray, np.ndarray],
-) -> float:
-    """Merge full blocks, a tail and a head piece into one window (Chan, Golub and LeVeque).
-
-    ``blocks = (b_mean (n, p), b_scat (n, p, p), lo, hi, size)``: blocks ``lo .. hi - 1``
-    of ``size`` rows; ``pieces = (t_size, t_mean, t_scat, h_size, h_mean, h_scat)``: the
-    tail (the rows before the first full block) and the head (the rows after the last);
-    a piece of size 0 is skipped. ``dev`` work space (pieces, p); ``out = (mean, scat)``.
-    Returns the row count.
-    """
-    b_mean, b_scat, lo, hi, size = blocks
-    t_size, t_mean, t_scat, h_size, h_mean, h_scat = pieces
-    mean, scat = out
-    p = mean.shape[0]
-    total = t_size + size * (hi - lo) + h_size
-    for a in range(p):
-        acc = t_size * t_mean[a] if t_size > 0 else 0.0
-        for k in range(lo, hi):
-            acc += size * b_mean[k, a]
-        if h_size > 0:
-            acc += h_size * h_mean[a]
-        mean[a] = acc / total
-    root = math.sqrt(size)
-    t_root = math.sqrt(t_size)
-    n_dev = hi - lo + 1
-    for a in range(p):
-        dev[0, a] = t_root * (t_mean[a] - mean[a]) if t_size > 0 else 0.0
-        for k in range(lo, hi):
-            dev[k - lo + 1, a] = root * (b_mean[k, a] - mean[a])
-        if h_size > 0:
-            dev[n_dev, a] = math.sqrt(h_size) * (h_mean[a] - mean[a])
-    if h_size > 0:
-        n_dev += 1
-    for a in range(p):
-        for b in range(a + 1):
-            acc = t_scat[a, b] if t_size > 0 else 0.0
-            for k in range(lo, hi):
-                acc += b_scat[k, a, b]
-            if h_size > 0:
-                acc += h_scat[a, b]
-            for k in range(n_dev):
-                acc += dev[k, a] * dev[k, b]
-            scat[a, b] = acc
-            scat[b, a] = acc
-    return float(total)
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
 def solve_one(
     scat: np.ndarray,
     mean: np.ndarray,
@@ -324,13 +225,16 @@ def solve_one(
             if not math.isfinite(scat[a, b]):
                 finite = False
     channel_scales(scat, n_rows, plan.col_channel, s.n_channels, scales)
-    solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
-    ok = finite and sym_eig(mat, vals, vecs, ework, True)
-    if ok and s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself
-        for a in range(p):
-            raw[a] = vals[a]
-    elif ok:
-        ok = sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
+    if s.transform_mode == NO_TRANSFORM:  # the solved problem is A itself (T = I, unused)
+        ok = finite and sym_eig(scat, vals, vecs, ework, True)
+        if ok:
+            for a in range(p):
+                raw[a] = vals[a]
+    else:
+        solved_matrix(scat, s.transform_mode, plan.transform, scales, tmat, mat)
+        ok = finite and sym_eig(mat, vals, vecs, ework, True)
+        if ok:
+            ok = sym_eig(scat, raw, mat, ework, False)  # the paper's eigenvalues, for D
     if not ok:
         for a in range(p):
             theta[a] = 0.0
@@ -346,78 +250,6 @@ def solve_one(
         plan.col_channel,
         (phi, theta, eigenvalues),
     )
-
-
-class BlockCache(NamedTuple):
-    """Statistics of the newest blocks, kept between kernel calls (see :func:`new_cache`).
-
-    A block's statistics are a function of its rows alone, so a block summarised by an
-    earlier call is reused bit for bit: ``step`` then summarises one new block per update
-    instead of the whole window. Blocks ``span[0] .. span[1] - 1`` are held, block ``k``
-    at ring position ``k % M`` (``M`` = the second axis; 0: no cache).
-    """
-
-    mean: np.ndarray  #: (E, M, p)
-    scat: np.ndarray  #: (E, M, p, p)
-    step: np.ndarray  #: (E, M)
-    span: np.ndarray  #: (2,) int64
-
-
-def new_cache(shape: tuple[int, int], ring: int) -> BlockCache:
-    """An empty :class:`BlockCache` of ``ring`` blocks per equation (0: caching off).
-
-    ``shape = (E, p)``: equations and parameters per equation.
-    """
-    n_eq, p = shape
-    return BlockCache(
-        np.zeros((n_eq, ring, p)),
-        np.zeros((n_eq, ring, p, p)),
-        np.zeros((n_eq, ring)),
-        np.zeros(2, np.int64),
-    )
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def gather_blocks(
-    samples: np.ndarray,
-    where: tuple[np.ndarray, np.ndarray, int, int, int, int],
-    cache: tuple[np.ndarray, np.ndarray, np.ndarray, int, int],
-    z: np.ndarray,
-    blocks: tuple[np.ndarray, np.ndarray, np.ndarray],
-) -> None:
-    """Statistics of blocks ``b_lo .. b_lo + n - 1`` of one equation, from the cache or rows.
-
-    ``where = (chan, lag, first, b_lo, n, size)``; ``cache = (mean (M, p), scat (M, p, p),
-    step (M,), lo, hi)``: one equation's ring and the blocks it holds; ``blocks = (b_mean,
-    b_scat, b_step)``. The newest ``min(n, M)`` blocks are written back into the ring.
-    """
-    chan, lag, first, b_lo, n, size = where
-    c_mean, c_scat, c_step, c_lo, c_hi = cache
-    b_mean, b_scat, b_step = blocks
-    ring = c_mean.shape[0]
-    p = c_mean.shape[1]
-    for b in range(n):
-        k = b_lo + b
-        if c_lo <= k < c_hi:
-            pos = k % ring
-            for a in range(p):
-                b_mean[b, a] = c_mean[pos, a]
-                for c in range(p):
-                    b_scat[b, a, c] = c_scat[pos, a, c]
-            b_step[b] = c_step[pos]
-        else:
-            lo = k * size
-            piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
-            b_step[b] = piece_step(samples, chan[0], first, (lo, lo + size))
-    if ring == 0:
-        return
-    for b in range(max(0, n - ring), n):
-        pos = (b_lo + b) % ring
-        for a in range(p):
-            c_mean[pos, a] = b_mean[b, a]
-            for c in range(p):
-                c_scat[pos, a, c] = b_scat[b, a, c]
-        c_step[pos] = b_step[b]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -455,7 +287,7 @@ def solve_windows(
     dev = np.empty((window // size + 3, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
-    z = np.empty(p)
+    z = np.empty((size, p))  # the rows of one piece
     work = new_work(p)
     c_lo, c_hi = cache.span[0], cache.span[1]
     for eq in range(n_eq):
