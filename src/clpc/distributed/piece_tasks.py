@@ -107,18 +107,16 @@ def trace_nbytes(trace: Trace) -> int:
 
 
 class SolvedPiece(NamedTuple):
-    """The solved windows of a piece, batch by batch (:func:`clpc.appraiser.kernel.batches`).
+    """A solved piece: its trace rows, written by the kernel as :meth:`clpc.CLPC.run` writes.
 
-    ``outputs`` is the FSM output from "no model yet" until :func:`settle` makes the first
+    ``trace`` holds the FSM output from "no model yet" until :func:`settle` makes the first
     updates the record's (in place; settling again gives the same).
     """
 
     piece: Piece
-    batches: list[tuple[int, int]]
-    solved: list[kernel.Solved]
-    outputs: list[kernel.FsmOutput]
+    trace: Trace  #: the piece's rows (``index``, ``time``, every array; levels in ``meta``)
+    solved_c: np.ndarray  #: (count, E): each window's own ``c`` (not a trace column)
     first_accepted: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
-    levels: np.ndarray | None  #: (count, n_out): each window's mean output (record samples)
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
 
 
@@ -131,8 +129,7 @@ else:
 
     @sizeof.register(SolvedPiece)
     def _solved_nbytes(solved: SolvedPiece) -> int:
-        parts = [*solved.solved, *solved.outputs]
-        return sum(a.nbytes for part in parts for a in part)
+        return trace_nbytes(solved.trace) + solved.solved_c.nbytes
 
 
 class PieceInfo(NamedTuple):
@@ -178,6 +175,10 @@ def _peaks(columns: list[np.ndarray]) -> np.ndarray:
 def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
     """Read (or take), check and decimate a piece's samples; solve its windows; run the FSM.
 
+    The kernel writes straight into the piece's trace arrays, batch by batch with its block
+    cache, as :meth:`clpc.CLPC.run` does (:func:`clpc.appraiser.kernel.solve_updates`): the
+    same operations, so the same numbers bit for bit, and no copy of the rows.
+
     Parameters
     ----------
     raw : (ndarray, ndarray) or source
@@ -199,24 +200,29 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
         n_in = plan.channels[0]
         u, y = as_chunk(both[:, :n_in], both[:, n_in:], piece.raw[0])
     samples = _kept(both, plan.layout, piece)
-    setup = plan.state().kernel_setup()
+    st = plan.state()
+    setup = st.kernel_setup()
+    trace = Trace.allocate(st.empty_trace(), piece.updates)
+    dest = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+    cache = kernel.new_cache(setup.plan.chan.shape, kernel.cache_blocks(setup.plan))
     first_row = piece.kept[0] - plan.layout.max_lag
-    batches = kernel.batches(piece.j_lo, piece.j_hi, 1)
-    solved = [kernel.solve(samples, first_row, b, setup) for b in batches]
-    state = kernel.FsmState(*plan.initial())
-    outputs = [kernel.output(s, setup, state) for s in solved]
-    accepted = np.concatenate([o.accepted for o in outputs])
+    fsm = kernel.FsmState(*plan.initial())
+    kernel.solve_updates(setup, (samples, first_row), (piece.j_lo, piece.j_hi), (fsm, cache), dest)
+    lay = plan.layout
+    trace.index[:] = lay.max_lag + lay.cluster * np.arange(piece.j_lo, piece.j_hi + 1) - 1
+    trace.time[:] = trace.index * trace.sample_time
+    accepted = trace.arrays["accepted"]
     first = np.where(accepted.any(axis=0), accepted.argmax(axis=0), -1)
-    rows = np.concatenate([s.n_rows for s in solved])
-    levels = _levels(y, plan, piece, rows) if plan.levels else None
+    if plan.levels:
+        trace.meta["window_level"] = _levels(y, plan, piece, trace.rows)
     peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
-    return SolvedPiece(piece, batches, solved, outputs, first, levels, peaks)
+    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks)
 
 
 def piece_info(solved: SolvedPiece) -> PieceInfo:
     """The extremes and the end state of a solved piece (see :func:`next_state`)."""
-    last = solved.outputs[-1]
-    end = (last.theta[-1].copy(), last.c[-1].copy(), last.has_model[-1].copy())
+    arrays = solved.trace.arrays
+    end = (arrays["theta"][-1].copy(), arrays["c"][-1].copy(), arrays["has_model"][-1].copy())
     return PieceInfo(solved.peaks, end, solved.first_accepted >= 0)
 
 
@@ -231,52 +237,27 @@ def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
     return theta, np.where(ok, info.end[1], state[1]), np.where(ok, info.end[2], state[2])
 
 
-def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> list[kernel.FsmOutput]:
+def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
     """The piece's FSM output as the record's, given the state the record is in before it.
 
     Runs the FSM from ``state`` over the updates before (and at) the last of the
     equations' first accepted updates (every update when an equation accepted none); the
-    later updates' outputs do not depend on ``state``. Updates ``solved.outputs`` in place.
+    later updates' outputs do not depend on ``state``. Writes into ``solved.trace`` (in
+    place) and returns it.
     """
+    trace = solved.trace
     ends = np.where(solved.first_accepted >= 0, solved.first_accepted, solved.piece.updates - 1)
     todo = int(ends.max()) + 1
     setup = plan.state().kernel_setup()
     carried = kernel.FsmState(*(np.array(a, copy=True) for a in state))
-    done = 0
-    for sol, out in zip(solved.solved, solved.outputs, strict=True):
-        n = min(out.theta.shape[0], todo - done)
-        if n <= 0:
-            break
-        head = kernel.Solved(*(a[:n] for a in sol))
-        again = kernel.output(head, setup, carried)
-        for have, want in zip(out, again, strict=True):
-            have[:n] = want
-        done += n
-    return solved.outputs
-
-
-def _arrays(sol: kernel.Solved, fsm: kernel.FsmOutput) -> dict[str, np.ndarray]:
-    """A trace part's per-update arrays: the FSM's output and the windows' own solution."""
-    arrays: dict[str, np.ndarray] = dict(fsm._asdict())
-    for key, value in sol._asdict().items():
-        if key not in ("theta", "c"):
-            arrays[key] = value
-    arrays["theta_estimate"] = sol.theta
-    return arrays
-
-
-def _trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
-    """The trace rows of a piece (``meta["window_level"]``: its windows' levels, if any)."""
-    labels = plan.state().trace_labels()
-    lay = plan.layout
-    parts = []
-    for (j0, count), sol, out in zip(solved.batches, solved.solved, outputs, strict=True):
-        arrays = _arrays(sol, out)
-        index = lay.max_lag + lay.cluster * np.arange(j0, j0 + count) - 1
-        parts.append(labels.trace(index, arrays.pop("n_rows"), arrays))
-    trace = parts[0] if len(parts) == 1 else Trace.concat(parts)
-    if solved.levels is not None:
-        trace.meta["window_level"] = solved.levels
+    windows, out = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+    head = kernel.Solved(*windows)._replace(c=solved.solved_c)
+    kernel.fsm_output(
+        kernel.Solved(*(a[:todo] for a in head)),
+        setup.fsm,
+        carried,
+        kernel.FsmOutput(*(a[:todo] for a in out)),
+    )
     return trace
 
 
@@ -285,4 +266,4 @@ def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trac
 
     ``state``: the record's FSM state before the piece (:func:`next_state`).
     """
-    return _trace(solved, settle(solved, plan, state), plan)
+    return settle(solved, plan, state)
