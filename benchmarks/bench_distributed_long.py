@@ -15,11 +15,19 @@ Runs, all in one invocation:
   file; the trace's rows come back to this process (as ``run`` returns them);
 * ``track_long N``: :func:`clpc.distributed.track_long`: the workers write the trace as a
   partitioned Parquet dataset; only the arrays of the summary, the updates of the report's
-  figures and the last updates come back (Dask's size estimates of the results).
+  figures and the last updates come back (Dask's size estimates of the results);
+* like with like for ``track_long``, whose work includes writing the trace and the summary
+  that ``CLPC.run`` does not: ``clpc track FILE -u 0 -y 1 --format parquet --out OUT`` in
+  one fresh process (:func:`clpc.workflows.track_file`: the Parquet trace file, the summary,
+  the figures and ``report.html``; warmed up on a short record first, so the plotting
+  imports are not timed), against ``clpc track ... --workers N`` on the same cluster
+  (``clpc_track N``: :func:`clpc.distributed.long_track.track_settings`, i.e.
+  ``track_long`` then the same report, warmed up the same way).
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
-kernel is loaded in each worker), then timed. The ``run_long`` trace is compared with the
-single-process trace array by array (SHA-256 of every array: bit for bit).
+kernel is loaded in each worker, the report's imports in this process), then timed. The
+``run_long`` trace is compared with the single-process trace array by array (SHA-256 of
+every array: bit for bit).
 
 Each distributed run is repeated ``--repeat`` times and the fastest kept (as ``single``).
 Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
@@ -61,6 +69,9 @@ DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.5, 0.3, 0.1])
 EQ_NOISE, MEAS_NOISE = 0.1, 0.02
 SEED = 20240607
+#: the distributed runs: run_long and track_long (against CLPC.run), and clpc track
+#: --workers (track_long and the report; against clpc track in one process)
+MODES = ("run_long", "track_long", "clpc_track")
 
 
 def generate_npy(path: Path, n: int, block: int = 1_000_000) -> None:
@@ -90,6 +101,31 @@ def digests(trace: Any) -> dict[str, str]:
 
 def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def track_settings_of(path: str, out: Path) -> Any:
+    """``clpc track PATH -u 0 -y 1 --format parquet --out OUT`` (default appraiser settings)."""
+    import clpc.workflows as wf
+
+    record = wf.RecordSpec(path, ("0",), ("1",))
+    return wf.TrackSettings(record, str(out), wf.AppraiserSettings(), fmt="parquet")
+
+
+def single_track(path: str, repeat: int) -> dict[str, Any]:
+    """``clpc track`` in this process (call it in a fresh one): trace file, summary, report."""
+    import clpc.workflows as wf
+
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = Path(tmpdir)
+        warm = tmp / "warm.npy"
+        np.save(warm, np.load(path, mmap_mode="r")[:50_000])
+        wf.track_file(track_settings_of(str(warm), tmp / "warm"))  # imports, compiled kernel
+        best = (np.inf, np.inf)
+        for i in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            result = wf.track_file(track_settings_of(path, tmp / f"out{i}"))
+            best = min(best, (time.perf_counter() - t0, time.process_time() - c0))
+    return {"wall": best[0], "cpu": best[1], "updates": result.summary["updates"]}
 
 
 def single(path: str, repeat: int) -> dict[str, Any]:
@@ -142,6 +178,7 @@ def distributed_runs(
 
     from clpc import CLPC
     from clpc.distributed import dask_client, run_long, track_long
+    from clpc.distributed.long_track import track_settings
     from clpc.distributed.sources import NpySource
 
     source = NpySource(path, (0,), (1,))
@@ -151,7 +188,9 @@ def distributed_runs(
     with dask_client(workers=n_workers) as client:
         for _ in range(2):  # every worker loads the kernel
             run_long(CLPC(), NpySource(str(warm), (0,), (1,)), client=client, piece_samples=10_000)
-        for mode in [m for m in ("run_long", "track_long") for _ in range(repeat)]:
+        # the report's imports in this process, as the single clpc track's warm-up does
+        track_settings(track_settings_of(str(warm), tmp / "warm"), client=client)
+        for mode in [m for m in MODES for _ in range(repeat)]:
             base = _incoming_bytes(client)
             rss0 = _peak_rss_mb()
             cpu0 = client.run(time.process_time)
@@ -161,11 +200,17 @@ def distributed_runs(
                     trace = run_long(CLPC(), source, client=client)
                     wall = time.perf_counter() - t0
                     updates = len(trace)
-                else:
+                elif mode == "track_long":
                     result = track_long(CLPC(), source, tmp / f"out{n_workers}", client=client)
                     wall = time.perf_counter() - t0
                     updates = result.summary["updates"]
                     result.close()
+                else:  # clpc track --workers N: track_long, then the report
+                    done, _ = track_settings(
+                        track_settings_of(path, tmp / f"cli{n_workers}"), client=client
+                    )
+                    wall = time.perf_counter() - t0
+                    updates = done.summary["updates"]
                 client_cpu = time.process_time() - c0
             cpu1 = client.run(time.process_time)
             worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
@@ -180,7 +225,7 @@ def distributed_runs(
             computing = sum(seconds.values())
             if to_client is None:  # summary, figures, last rows: Dask's sizes of the results
                 to_client = sum(
-                    t["nbytes"] for t in ts.data if str(t["key"]).startswith("write_piece")
+                    t.get("nbytes", 0) for t in ts.data if str(t["key"]).startswith("write_piece")
                 )
             worker_rss = client.run(
                 lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -208,11 +253,14 @@ def distributed_runs(
 
 def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     secs, wall = row["seconds"], row["wall"]
+    if row["mode"] == "clpc_track":  # like with like: against clpc track in one process
+        ref = ref["track"]
     info = secs.get("piece_info", 0.0)
     finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
     print(
         f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
-        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x  "
+        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x "
+        f"(vs {'clpc track' if row['mode'] == 'clpc_track' else 'CLPC.run'})  "
         f"equal to single: {row['equal']}"
     )
     print(
@@ -236,9 +284,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeat", type=int, default=1, help="repetitions of each run (best kept)")
     parser.add_argument("--single-worker", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--single-track", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.single_worker:
         print(json.dumps(single(args.single_worker[0], int(args.single_worker[1]))))
+        return
+    if args.single_track:
+        print(json.dumps(single_track(args.single_track[0], int(args.single_track[1]))))
         return
     n = int(1e6 if args.quick else args.samples)
     print(f"load average before: {os.getloadavg()}; cores: {os.cpu_count()}")
@@ -254,14 +306,24 @@ def main() -> None:
         ref = json.loads(
             subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
         )
+        cmd = [sys.executable, __file__, "--single-track", str(path), str(args.repeat)]
+        ref["track"] = json.loads(
+            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
+        )
         print(
             f"\nsingle      wall {ref['wall']:7.2f} s  cpu {ref['cpu']:7.2f} s  "
             f"{n / ref['wall']:10.3g} samples/s  {ref['updates']} updates  "
             f"peak RSS added {ref['rss_added_mb']:.0f} MB"
         )
+        track = ref["track"]
+        print(
+            f"clpc track  wall {track['wall']:7.2f} s  cpu {track['cpu']:7.2f} s  "
+            f"{n / track['wall']:10.3g} samples/s  {track['updates']} updates "
+            "(one process: Parquet trace file, summary, figures, report)"
+        )
         for w in args.workers:
             rows = distributed_runs(str(path), w, ref, tmp, args.repeat)
-            for mode in ("run_long", "track_long"):
+            for mode in MODES:
                 _show(min((r for r in rows if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
     print(f"\nload average after: {os.getloadavg()}")
 
