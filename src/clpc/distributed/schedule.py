@@ -1,12 +1,14 @@
 """How a long record's pieces are given to a Dask cluster (see :mod:`.long_record`).
 
-:func:`run_pieces` submits each piece's solve (:func:`.piece_tasks.solve_piece`) and, as
-the solved pieces' few numbers arrive in time order (:func:`.piece_tasks.piece_info`), the
-record's FSM state at each piece's start (:func:`.piece_tasks.next_state`, on the client);
-then the piece's finish on the worker that holds it, with that state. No task waits for
-another piece's. At most :data:`AHEAD` pieces per worker are in flight, so a worker's
-memory is O(piece) whatever the record's length; what the finishes return is taken in time
-order.
+:func:`run_pieces` keeps one piece's solve (:func:`.piece_tasks.solve_piece`) per worker
+in flight, so that a worker's next task after a solve is that piece's few numbers
+(:func:`.piece_tasks.piece_info`), not another solve that would hold them back until it
+ends, and a worker that is free takes the next piece (a worker slowed by another job solves
+fewer). As the pieces' numbers arrive, the client carries the record's FSM state to each
+piece's start in time order (:func:`.piece_tasks.next_state`) and sends the piece's finish,
+with that state, to the worker that holds it. No task waits for another piece's. At most
+:data:`AHEAD` pieces per worker are held, so a worker's memory is O(piece) whatever the
+record's length; what the finishes return is taken in time order.
 """
 
 from __future__ import annotations
@@ -103,32 +105,44 @@ def run_pieces(
         last = pieces[-1]
         pieces[-1] = last._replace(raw=(last.raw[0], plan.n_raw))
     read = _reader(record)
-    limit = AHEAD * n_workers
-    state: Any = plan.initial()
-    solving: deque[tuple[Any, Any]] = deque()  # (solved, info) futures, in time order
-    finishing: deque[Any] = deque()
+    peaks = np.array([[-np.inf], [np.inf]]) * np.ones(sum(plan.channels))
     results: list[Any] = []
     take = results.append if sink is None else sink
-    peaks = np.array([[-np.inf], [np.inf]]) * np.ones(sum(plan.channels))
     todo = deque(pieces)
-    while todo or solving or finishing:
-        while todo and len(solving) + len(finishing) < limit:
+    solving: dict[int, tuple[Any, Any]] = {}  # piece number: (solved, info) futures
+    solved: dict[int, tuple[Any, Any]] = {}  # piece number: (solved future, PieceInfo)
+    finishing: deque[Any] = deque()  # in time order
+    state: Any = plan.initial()
+    after = 0  # the piece whose finish is submitted next (the record's state is before it)
+    while todo or solving or solved or finishing:
+        # one solve per worker at a time: the worker's next task after a solve is its
+        # piece_info (not another solve), and a free worker takes the next piece; at most
+        # AHEAD pieces per worker held
+        while (
+            todo
+            and len(solving) < n_workers
+            and len(solving) + len(solved) + len(finishing) < AHEAD * n_workers
+        ):
             piece = todo.popleft()
-            solved = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
-            solving.append((solved, client.submit(piece_info, solved, pure=False)))
-        if solving and solving[0][1].done():
-            solved, info = solving.popleft()
+            fut = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
+            solving[piece.number] = (fut, client.submit(piece_info, fut, pure=False))
+        for number in [k for k, (_, info) in solving.items() if info.done()]:
+            fut, info = solving.pop(number)
             part = info.result()  # raises the worker's error (e.g. a sample not finite)
-            finishing.append(_finish(client, solved, (plan, state), finish))
-            state = next_state(state, part)
+            solved[number] = (fut, part)
             peaks = np.stack([np.maximum(peaks[0], part.peaks[0]),
                               np.minimum(peaks[1], part.peaks[1])])  # fmt: skip
-        elif finishing and finishing[0].done():
+        while after in solved:  # in time order: the record's state before each piece
+            fut, part = solved.pop(after)
+            finishing.append(_finish(client, fut, (plan, state), finish))
+            state = next_state(state, part)
+            after += 1
+        if finishing and finishing[0].done():
             take(finishing.popleft().result())
-        else:
-            oldest = [solving[0][1]] if solving else []
-            oldest += [finishing[0]] if finishing else []
-            distributed.wait(oldest, return_when="FIRST_COMPLETED")
+        elif solving or finishing:
+            waiting = [info for _, info in solving.values()]
+            waiting += [finishing[0]] if finishing else []
+            distributed.wait(waiting, return_when="FIRST_COMPLETED")
     return results, peaks
 
 
