@@ -27,11 +27,10 @@ from clpc.appraiser.trace import Trace
 from clpc.data import DataError
 from clpc.data.samples import check_ranges
 from clpc.distributed.cluster import dask_client
-from clpc.distributed.piece_tasks import (
-    RecordPlan,
-)
+from clpc.distributed.piece_tasks import RecordPlan, RowsInPlace, finish_piece
 from clpc.distributed.pieces import Layout
 from clpc.distributed.schedule import run_pieces
+from clpc.distributed.shared_rows import SharedRows
 from clpc.distributed.sources import NpySource, ParquetSource
 
 __all__ = [
@@ -104,15 +103,24 @@ def gather(parts: list[Trace]) -> Trace:
 
 
 class _Joined:
-    """A record's trace filled piece by piece as the pieces arrive (one copy in memory)."""
+    """A record's trace filled piece by piece as the pieces arrive (one copy in memory).
 
-    def __init__(self, total: int) -> None:
+    ``trace``: the record's trace in shared memory, which the workers of this machine
+    write themselves (:class:`.shared_rows.SharedRows`); else made from the first piece.
+    """
+
+    def __init__(self, total: int, trace: Trace | None = None) -> None:
         self.total = total
-        self.trace: Trace | None = None
+        self.trace = trace
         self.done = 0
         self.levels: list[np.ndarray] = []
 
-    def add(self, part: Trace) -> None:
+    def add(self, part: Trace | RowsInPlace) -> None:
+        if isinstance(part, RowsInPlace):  # written by the worker
+            assert part.start == self.done and part.levels is not None, part.start
+            self.done += part.n_rows
+            self.levels.append(part.levels)
+            return
         if self.trace is None:
             self.trace = Trace.allocate(part, self.total)
         self.done = self.trace.put(self.done, part)
@@ -204,8 +212,16 @@ def run_long(
             config = appraiser.config()
             short = dask.submit(_short_record, config, raw, channels[0], dt, pure=False)
             return short.result()
-        joined = _Joined(plan.layout.updates(n_raw))
-        _, peaks = run_pieces(dask, plan, record, piece_samples, sink=joined.add)
+        total = plan.layout.updates(n_raw)
+        made = SharedRows.create(plan.state().empty_trace(), total)
+        shared, trace = made if made is not None else (None, None)
+        joined = _Joined(total, trace)
+        try:
+            finish = (finish_piece, (shared,))
+            _, peaks = run_pieces(dask, plan, record, piece_samples, finish, joined.add, shared)
+        finally:
+            if shared is not None:
+                shared.remove()
     check_peaks(appraiser, peaks, channels[0])
     return joined.result()
 

@@ -25,6 +25,7 @@ goes from the client to a worker.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -37,10 +38,12 @@ from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
 from clpc.distributed.pieces import Layout, Piece
+from clpc.distributed.shared_rows import SharedRows
 
 __all__ = [
     "PieceInfo",
     "RecordPlan",
+    "RowsInPlace",
     "SolvedPiece",
     "finish_piece",
     "next_state",
@@ -118,6 +121,15 @@ class SolvedPiece(NamedTuple):
     solved_c: np.ndarray  #: (count, E): each window's own ``c`` (not a trace column)
     first_accepted: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
+    shared: bool  #: the kernel wrote ``trace`` into the record's shared trace (SharedRows)
+
+
+class RowsInPlace(NamedTuple):
+    """What a finish returns when the piece's rows are in the record's shared trace."""
+
+    start: int  #: the piece's first row in the record's trace
+    n_rows: int  #: its rows
+    levels: np.ndarray | None  #: (count, n_out): its windows' levels, if computed
 
 
 try:  # Dask's memory accounting sizes a returned trace or solved piece by its arrays
@@ -172,7 +184,9 @@ def _peaks(columns: list[np.ndarray]) -> np.ndarray:
     return np.array([[c.max() for c in columns], [c.min() for c in columns]])
 
 
-def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
+def solve_piece(
+    raw: Any, plan: RecordPlan, piece: Piece, shared: SharedRows | None = None
+) -> SolvedPiece:
     """Read (or take), check and decimate a piece's samples; solve its windows; run the FSM.
 
     The kernel writes straight into the piece's trace arrays, batch by batch with its block
@@ -186,6 +200,9 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
         source with a ``read(lo, hi)`` method (:mod:`clpc.distributed.sources`), read here.
     plan : RecordPlan
     piece : Piece
+    shared : SharedRows, optional
+        The record's trace in shared memory: when this process sees it, the kernel writes
+        the piece's rows there (else into the piece's own arrays).
 
     Raises
     ------
@@ -202,7 +219,12 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
     samples = _kept(both, plan.layout, piece)
     st = plan.state()
     setup = st.kernel_setup()
-    trace = Trace.allocate(st.empty_trace(), piece.updates)
+    whole = shared.open(st.empty_trace()) if shared is not None else None
+    if whole is None:
+        trace = Trace.allocate(st.empty_trace(), piece.updates)
+    else:  # rows of the shared trace (its own meta: the levels go back with the finish)
+        view = whole.view(piece.j_lo - 1, piece.j_hi)
+        trace = dataclasses.replace(view, meta=dict(view.meta))
     dest = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
     cache = kernel.new_cache(setup.plan.chan.shape, kernel.cache_blocks(setup.plan))
     first_row = piece.kept[0] - plan.layout.max_lag
@@ -216,7 +238,7 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
     if plan.levels:
         trace.meta["window_level"] = _levels(y, plan, piece, trace.rows)
     peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
-    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks)
+    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks, whole is not None)
 
 
 def piece_info(solved: SolvedPiece) -> PieceInfo:
@@ -237,13 +259,13 @@ def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
     return theta, np.where(ok, info.end[1], state[1]), np.where(ok, info.end[2], state[2])
 
 
-def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
-    """The piece's FSM output as the record's, given the state the record is in before it.
+def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> int:
+    """Make the piece's FSM output the record's, given the state the record is in before it.
 
     Runs the FSM from ``state`` over the updates before (and at) the last of the
     equations' first accepted updates (every update when an equation accepted none); the
     later updates' outputs do not depend on ``state``. Writes into ``solved.trace`` (in
-    place) and returns it.
+    place) and returns the number of rows it wrote (the piece's first ones).
     """
     trace = solved.trace
     ends = np.where(solved.first_accepted >= 0, solved.first_accepted, solved.piece.updates - 1)
@@ -258,12 +280,25 @@ def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
         carried,
         kernel.FsmOutput(*(a[:todo] for a in out)),
     )
-    return trace
+    return todo
 
 
-def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
+def finish_piece(
+    solved: SolvedPiece, plan: RecordPlan, state: FsmTuple, shared: SharedRows | None = None
+) -> Trace | RowsInPlace:
     """The piece's trace rows (what :meth:`clpc.CLPC.run` returns for these updates).
 
-    ``state``: the record's FSM state before the piece (:func:`next_state`).
+    ``state``: the record's FSM state before the piece (:func:`next_state`). With
+    ``shared``, when the piece was solved into the record's shared trace and this process
+    sees it: the settled rows are written there and only :class:`RowsInPlace` returned
+    (the rows settled are written again, as ``solved`` may be a copy moved from another
+    worker of this machine).
     """
-    return settle(solved, plan, state)
+    todo = settle(solved, plan, state)
+    trace = solved.trace
+    whole = shared.open(trace) if shared is not None and solved.shared else None
+    if whole is None:
+        return trace
+    start = solved.piece.j_lo - 1
+    whole.put(start, trace.take(slice(0, todo)))
+    return RowsInPlace(start, len(trace), trace.meta.get("window_level"))

@@ -72,6 +72,7 @@ def run_pieces(
     piece_samples: int | None = None,
     finish: tuple[Callable[..., Any], tuple[Any, ...]] = (finish_piece, ()),
     sink: Callable[[Any], None] | None = None,
+    shared: Any = None,
 ) -> tuple[list[Any], np.ndarray]:
     """Run every piece of a record on ``client``.
 
@@ -89,6 +90,9 @@ def run_pieces(
     sink : callable, optional
         Called with what ``finish`` returned for each piece, in time order, as it arrives
         (then not kept: ``parts`` is empty).
+    shared : SharedRows, optional
+        The record's trace in shared memory, for the solves
+        (:func:`.piece_tasks.solve_piece`).
 
     Returns
     -------
@@ -124,7 +128,8 @@ def run_pieces(
             and len(solving) + len(solved) + len(finishing) < AHEAD * n_workers
         ):
             piece = todo.popleft()
-            fut = client.submit(solve_piece, read(client, piece), plan, piece, pure=False)
+            job = (read(client, piece), plan, piece, shared)
+            fut = client.submit(solve_piece, *job, pure=False)
             solving[piece.number] = (fut, client.submit(piece_info, fut, pure=False))
         for number in [k for k, (_, info) in solving.items() if info.done()]:
             fut, info = solving.pop(number)

@@ -1,0 +1,145 @@
+"""A long record's trace in the memory of one machine, its rows written in place by the workers.
+
+:func:`clpc.distributed.run_long` returns the record's whole trace, about 300 bytes per
+update, as :meth:`clpc.CLPC.run` does. Sent piece by piece, those rows cost the workers
+their sending and the client receiving them, decoding them and copying them into the
+record's trace, on the cores the workers need. So the client lays the record's trace
+arrays out in one file of ``/dev/shm`` (a tmpfs: memory, not disk; the space reserved up
+front with ``posix_fallocate``, so a full tmpfs is refused there rather than faulting
+later) and maps it (:meth:`SharedRows.create`); a worker that sees the file, which only a
+process of the same machine can, maps it too (:meth:`SharedRows.open`) and its kernel
+writes the piece's rows straight into it. The file is removed when the record is done;
+the client's map, and so its trace, stays until the trace is let go.
+
+A worker that does not see the file (another machine, or a container with its own
+``/dev/shm``) solves into its own arrays and sends the rows, as it would without this.
+"""
+
+from __future__ import annotations
+
+import math
+import mmap
+import os
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from clpc.appraiser.trace import Trace
+
+__all__ = ["SHM", "SharedRows"]
+
+#: the tmpfs the shared trace is made in
+SHM = Path("/dev/shm")
+#: every array starts at a multiple of this many bytes
+ALIGN = 64
+
+#: one array of the trace: (shape, dtype string, byte offset in the file)
+Slot = tuple[tuple[int, ...], str, int]
+
+
+class _Views:
+    """``empty(shape, dtype)`` for :meth:`Trace.allocate`: consecutive aligned views of a map.
+
+    Without a map it only lays the arrays out (returning empty arrays); with ``expect`` it
+    checks that the arrays asked for are those laid out.
+    """
+
+    def __init__(self, buf: mmap.mmap | None = None, expect: tuple[Slot, ...] = ()) -> None:
+        self.buf, self.expect = buf, expect
+        self.slots: list[Slot] = []
+        self.size = 0
+
+    def __call__(self, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+        kind = np.dtype(dtype)
+        count = math.prod(shape)
+        slot = (tuple(int(n) for n in shape), kind.str, self.size)
+        if self.expect and self.expect[len(self.slots)] != slot:
+            raise ValueError(
+                f"the shared trace's array {len(self.slots)} is {self.expect[len(self.slots)]}, "
+                f"not {slot}: a trace of another appraiser."
+            )
+        self.slots.append(slot)
+        self.size += -(-count * kind.itemsize // ALIGN) * ALIGN
+        if self.buf is None:
+            return np.empty((0, *shape[1:]), kind)
+        return np.frombuffer(self.buf, kind, count=count, offset=slot[2]).reshape(shape)
+
+
+@dataclass(frozen=True)
+class SharedRows:
+    """Where a record's trace lies in a shared file (small and picklable).
+
+    Parameters
+    ----------
+    path : str
+        The file in :data:`SHM`.
+    rows : int
+        Updates of the record.
+    slots : tuple
+        ``(shape, dtype, offset)`` of every array, in the order :meth:`Trace.allocate`
+        makes them.
+    size : int
+        Bytes of the file.
+    """
+
+    path: str
+    rows: int
+    slots: tuple[Slot, ...]
+    size: int
+
+    @classmethod
+    def create(
+        cls, like: Trace, rows: int, folder: Path | None = None
+    ) -> tuple[SharedRows, Trace] | None:
+        """Make the shared file of a trace of ``rows`` updates shaped like ``like``, and map it.
+
+        ``folder``: where (default :data:`SHM`).
+
+        Returns
+        -------
+        (SharedRows, Trace) or None
+            The layout for the workers and the client's trace over the file; ``None`` when
+            ``folder`` is missing or has no room (the rows are then sent).
+        """
+        plan = _Views()
+        Trace.allocate(like, rows, empty=plan)
+        path = (SHM if folder is None else folder) / f"clpc-trace-{uuid.uuid4().hex}"
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o600)
+        except OSError:
+            return None
+        try:
+            os.posix_fallocate(fd, 0, plan.size)
+            buf = mmap.mmap(fd, plan.size)
+        except OSError:
+            path.unlink(missing_ok=True)
+            return None
+        finally:
+            os.close(fd)
+        shared = cls(str(path), rows, tuple(plan.slots), plan.size)
+        return shared, Trace.allocate(like, rows, empty=_Views(buf, shared.slots))
+
+    def open(self, like: Trace) -> Trace | None:
+        """The trace over the shared file, mapped in this process (``None``: it is not seen).
+
+        ``like``: a trace of the record's appraiser. The arrays are views of a map of the
+        file, kept as long as they are.
+        """
+        try:
+            fd = os.open(self.path, os.O_RDWR)
+        except OSError:
+            return None
+        try:
+            if os.fstat(fd).st_size != self.size:
+                return None
+            buf = mmap.mmap(fd, self.size)
+        finally:
+            os.close(fd)
+        return Trace.allocate(like, self.rows, empty=_Views(buf, self.slots))
+
+    def remove(self) -> None:
+        """Remove the file (the maps stay valid until their arrays are let go)."""
+        Path(self.path).unlink(missing_ok=True)
