@@ -1,18 +1,22 @@
 """How a long record's pieces are given to a Dask cluster (see :mod:`.long_record`).
 
-:func:`run_pieces` keeps one piece's solve (:func:`.piece_tasks.solve_piece`) per worker
-in flight, so that a worker's next task after a solve is that piece's few numbers
-(:func:`.piece_tasks.piece_info`), not another solve that would hold them back until it
-ends, and a worker that is free takes the next piece (a worker slowed by another job solves
-fewer). As the pieces' numbers arrive, the client carries the record's FSM state to each
-piece's start in time order (:func:`.piece_tasks.next_state`) and sends the piece's finish,
-with that state, to the worker that holds it. No task waits for another piece's. At most
+:func:`run_pieces` gives each worker two solves at a time (:data:`SOLVING`: the one it
+runs and the next, so it never waits for the client between pieces), the next piece to the
+worker that ended one (a worker slowed by another job solves fewer). As a solve ends, the
+worker tells the client the piece's few numbers (:func:`.piece_tasks.piece_info`) in a Dask
+event (``Worker.log_event`` / ``Client.subscribe_topic``), because a ``piece_info`` task
+would wait behind the worker's next solve; the task is still submitted, and taken when an
+event is lost. The client carries the record's FSM state to each piece's start in time
+order (:func:`.piece_tasks.next_state`) and sends the piece's finish, with that state, to
+the worker that holds it (first in its queue). No task waits for another piece's. At most
 :data:`AHEAD` pieces per worker are held, so a worker's memory is O(piece) whatever the
 record's length; what the finishes return is taken in time order.
 """
 
 from __future__ import annotations
 
+import threading
+import uuid
 from collections import deque
 from collections.abc import Callable
 from typing import Any
@@ -21,6 +25,7 @@ import numpy as np
 
 from clpc.distributed.cluster import require_distributed
 from clpc.distributed.piece_tasks import (
+    PieceInfo,
     RecordPlan,
     finish_piece,
     next_state,
@@ -50,6 +55,11 @@ PIECES_PER_WORKER = 3
 MIN_PIECE_WINDOWS = 64
 #: pieces in flight per worker (submitted, not yet taken by the client)
 AHEAD = 3
+#: solves given to a worker at a time: the one it runs and the next, so it starts the next
+#: as soon as one ends
+SOLVING = 2
+#: the Dask event topic (and a run's own suffix) on which workers tell a piece is solved
+TOPIC = "clpc-piece-solved"
 
 
 def _reader(record: Any) -> Callable[[Any, Piece], Any]:
@@ -101,8 +111,9 @@ def run_pieces(
     peaks : ndarray, shape (2, channels)
         The maximum and the minimum of every raw channel of the record.
     """
-    distributed = require_distributed()
-    n_workers = max(1, len(client.scheduler_info().get("workers", {})))
+    require_distributed()
+    addresses = list(client.scheduler_info().get("workers", {})) or [None]
+    n_workers = len(addresses)
     size = piece_samples or default_piece_samples(plan, n_workers)
     pieces = plan.layout.pieces(plan.n_raw, size)
     if pieces:  # the last piece reads to the end (the whole record is checked)
@@ -113,60 +124,129 @@ def run_pieces(
     results: list[Any] = []
     take = results.append if sink is None else sink
     todo = deque(pieces)
+    news = _News(f"{TOPIC}-{uuid.uuid4().hex}")
+    free = deque(addresses * SOLVING)  # a worker once per solve it may be given
     solving: dict[int, tuple[Any, Any]] = {}  # piece number: (solved, info) futures
-    solved: dict[int, tuple[Any, Any]] = {}  # piece number: (solved future, PieceInfo)
+    solved: dict[int, tuple[Any, Any, Any]] = {}  # piece number: (future, PieceInfo, worker)
     finishing: deque[Any] = deque()  # in time order
     state: Any = plan.initial()
     after = 0  # the piece whose finish is submitted next (the record's state is before it)
-    while todo or solving or solved or finishing:
-        # one solve per worker at a time: the worker's next task after a solve is its
-        # piece_info (not another solve), and a free worker takes the next piece; at most
-        # AHEAD pieces per worker held
-        while (
-            todo
-            and len(solving) < n_workers
-            and len(solving) + len(solved) + len(finishing) < AHEAD * n_workers
-        ):
-            piece = todo.popleft()
-            job = (read(client, piece), plan, piece, shared)
-            fut = client.submit(solve_piece, *job, pure=False)
-            solving[piece.number] = (fut, client.submit(piece_info, fut, pure=False))
-        for number in [k for k, (_, info) in solving.items() if info.done()]:
-            fut, info = solving.pop(number)
-            part = info.result()  # raises the worker's error (e.g. a sample not finite)
-            solved[number] = (fut, part)
-            peaks = np.stack([np.maximum(peaks[0], part.peaks[0]),
-                              np.minimum(peaks[1], part.peaks[1])])  # fmt: skip
-        while after in solved:  # in time order: the record's state before each piece
-            fut, part = solved.pop(after)
-            finishing.append(_finish(client, fut, (plan, state), finish))
-            state = next_state(state, part)
-            after += 1
-        if finishing and finishing[0].done():
-            take(finishing.popleft().result())
-        elif solving or finishing:
-            waiting = [info for _, info in solving.values()]
-            waiting += [finishing[0]] if finishing else []
-            distributed.wait(waiting, return_when="FIRST_COMPLETED")
+    client.subscribe_topic(news.topic, news.hear)
+    try:
+        while todo or solving or solved or finishing:
+            while todo and free and len(solving) + len(solved) + len(finishing) < AHEAD * n_workers:
+                piece, where = todo.popleft(), free.popleft()
+                job = (news.topic, read(client, piece), plan, piece, shared)
+                key = f"solve_piece-{uuid.uuid4().hex}"  # named as what it runs
+                fut = client.submit(_solve_and_tell, *job, key=key, **_on(where))
+                info = client.submit(piece_info, fut, pure=False)
+                info.add_done_callback(news.wake_up)
+                solving[piece.number] = (fut, info)
+            for number in [k for k, (_, i) in solving.items() if k in news.heard or i.done()]:
+                fut, info = solving.pop(number)
+                heard = news.heard.pop(number, None)
+                part, where = heard if heard is not None else (info.result(), None)
+                free.append(where)  # that worker's next solve (None: any worker)
+                solved[number] = (fut, part, where)
+                peaks = np.stack([np.maximum(peaks[0], part.peaks[0]),
+                                  np.minimum(peaks[1], part.peaks[1])])  # fmt: skip
+            while after in solved:  # in time order: the record's state before each piece
+                fut, part, where = solved.pop(after)
+                finishing.append(_finish(client, fut, (plan, state, where), finish))
+                finishing[-1].add_done_callback(news.wake_up)
+                state = next_state(state, part)
+                after += 1
+            if finishing and finishing[0].done():
+                take(finishing.popleft().result())
+            elif solving or finishing:
+                news.wait()
+    finally:
+        client.unsubscribe_topic(news.topic)
     return results, peaks
+
+
+def _on(where: str | None) -> dict[str, Any]:
+    """Submit keywords: prefer the worker ``where`` (another takes the task if it is lost)."""
+    return {} if where is None else {"workers": [where], "allow_other_workers": True}
+
+
+class _News:
+    """What the client hears of solved pieces: the workers' events, and futures done."""
+
+    def __init__(self, topic: str) -> None:
+        self.topic = topic
+        self.heard: dict[int, tuple[PieceInfo, str]] = {}  # piece number: (info, worker)
+        self.event = threading.Event()
+
+    def hear(self, event: tuple[float, dict[str, Any]]) -> None:
+        """Handler of the topic's events (the client's event loop calls it)."""
+        msg = event[1]
+        self.heard[int(msg["piece"])] = (_unplain(msg["info"]), str(msg["worker"]))
+        self.event.set()
+
+    def wake_up(self, _: Any = None) -> None:
+        """A future is done (its callback)."""
+        self.event.set()
+
+    def wait(self) -> None:
+        """Until something is heard or a future is done."""
+        self.event.wait()
+        self.event.clear()
+
+
+def _solve_and_tell(topic: str, *job: Any) -> Any:
+    """:func:`.piece_tasks.solve_piece`, then tell the client the piece's few numbers at once.
+
+    As a Dask event on ``topic`` (with this worker's address), sent as the solve ends: the
+    worker's next solve may already be waiting, and the ``piece_info`` task (kept, in case
+    the event is lost) runs only after it.
+    """
+    solved = solve_piece(*job)
+    distributed = require_distributed()
+    try:
+        worker = distributed.get_worker()
+    except ValueError:  # pragma: no cover - run outside a worker: the piece_info task tells
+        return solved
+    msg = {"piece": solved.piece.number, "worker": worker.address}
+    worker.log_event(topic, {**msg, "info": _plain(piece_info(solved))})
+    return solved
+
+
+def _plain(info: PieceInfo) -> dict[str, Any]:
+    """A piece's numbers as lists (an event is msgpack: float64 values round-trip exactly)."""
+    theta, c, has_model = info.end
+    return {
+        "peaks": info.peaks.tolist(),
+        "end": [theta.tolist(), c.tolist(), has_model.tolist()],
+        "accepted": info.accepted.tolist(),
+    }
+
+
+def _unplain(msg: dict[str, Any]) -> PieceInfo:
+    """:func:`_plain` undone (the same arrays, the same values)."""
+    theta, c, has_model = msg["end"]
+    end = (np.array(theta, dtype=np.float64), np.array(c, dtype=np.float64),
+           np.array(has_model, dtype=bool))  # fmt: skip
+    peaks = np.array(msg["peaks"], dtype=np.float64)
+    return PieceInfo(peaks, end, np.array(msg["accepted"], dtype=bool))
 
 
 def _finish(
     client: Any,
     solved: Any,
-    job: tuple[RecordPlan, Any],
+    job: tuple[RecordPlan, Any, str | None],
     finish: tuple[Callable[..., Any], tuple[Any, ...]],
 ) -> Any:
-    """Submit a solved piece's finish on the worker that holds it.
+    """Submit a solved piece's finish on the worker that holds it, before its next solve.
 
     A preference: another worker takes it if that one is lost. So only the FSM state moves
     between processes.
     """
-    plan, state = job
-    where = list(client.who_has(solved).get(solved.key, ()))
-    kw: dict[str, Any] = {"pure": False}
-    if where:
-        kw.update(workers=where, allow_other_workers=True)
+    plan, state, where = job
+    if where is None:
+        held = list(client.who_has(solved).get(solved.key, ()))
+        where = held[0] if held else None
+    kw = {"pure": False, "priority": 1, **_on(where)}
     return client.submit(finish[0], solved, plan, state, *finish[1], **kw)
 
 
