@@ -38,7 +38,8 @@ the wall time; the scheduler overhead per piece = (N x wall - computing) / piece
 worker was not computing: scheduling, transfers, waiting for a core or for the client);
 bytes per piece sent between
 workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
-(the pickled size of every result); peak RSS of each worker and of this process (added by
+(Dask's sizes of the finishes' results: with ``run_long`` on one machine only the windows'
+levels, the rows being in the shared trace); peak RSS of each worker and of this process (added by
 the run). The load average is printed before and after: the machine may be shared.
 
 Usage::
@@ -53,7 +54,6 @@ import argparse
 import hashlib
 import json
 import os
-import pickle
 import resource
 import subprocess
 import sys
@@ -214,19 +214,21 @@ def distributed_runs(
                 client_cpu = time.process_time() - c0
             cpu1 = client.run(time.process_time)
             worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
-            equal, to_client = None, None
+            equal = None
             if mode == "run_long":  # checked after the timing
                 equal = digests(trace) == reference["digests"]
-                # what came back: the trace rows (pickled sizes of the arrays)
-                to_client = sum(len(pickle.dumps(a, protocol=5)) for a in trace.arrays.values())
                 del trace
             seconds = _task_seconds(ts.data)
             pieces = sum(1 for t in ts.data if str(t["key"]).startswith("solve_piece"))
             computing = sum(seconds.values())
-            if to_client is None:  # summary, figures, last rows: Dask's sizes of the results
-                to_client = sum(
-                    t.get("nbytes", 0) for t in ts.data if str(t["key"]).startswith("write_piece")
-                )
+            # what the finishes sent back: Dask's sizes of the results (run_long: the rows,
+            # or only the levels when the workers wrote the rows into the shared trace;
+            # track_long: summary arrays, figures' and last rows)
+            to_client = sum(
+                t.get("nbytes", 0)
+                for t in ts.data
+                if str(t["key"]).startswith(("finish_piece", "write_piece"))
+            )
             worker_rss = client.run(
                 lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
             )
