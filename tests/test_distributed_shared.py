@@ -7,6 +7,7 @@ trace equals ``CLPC.run``'s bit for bit; the reference is the single-process run
 
 from __future__ import annotations
 
+import os
 import pickle
 
 import numpy as np
@@ -139,3 +140,24 @@ def test_run_long_is_clpc_run_with_or_without_shared_memory(client, monkeypatch,
     levels = (got.meta["window_level"], ref.meta["window_level"])
     np.testing.assert_allclose(*levels, rtol=1e-12, atol=1e-13)  # as test_distributed_long
     assert _shm_files() == before  # the file is removed when the record is done
+
+
+@needs_shm
+def test_the_file_is_sparse_until_a_writer_reserves_its_rows(monkeypatch):
+    plan, _ = _pieces(12_011, {"window_size": 60, "cluster_size": 6}, 2_000)
+    like = plan.state().empty_trace()
+    shared, trace = SharedRows.create(like, 2_000)
+    try:
+        assert os.stat(shared.path).st_blocks == 0  # the client zeroes nothing
+        whole = shared.open(like, (0, 1_000))
+        assert whole is not None
+        per_row = sum(a.nbytes for a in _arrays(trace).values()) // len(trace)
+        assert os.stat(shared.path).st_blocks * 512 >= 1_000 * per_row
+        whole.arrays["theta"][:1_000] = 1.5  # seen through the client's map
+        assert np.all(trace.arrays["theta"][:1_000] == 1.5)
+    finally:
+        shared.remove()
+    # a tmpfs without twice the room: no shared trace (the rows are then sent)
+    small = os.statvfs_result((4096, 4096, 10, 1, 1, 10, 1, 1, 0, 255))
+    monkeypatch.setattr(shared_rows.os, "statvfs", lambda path: small)
+    assert SharedRows.create(like, 2_000) is None

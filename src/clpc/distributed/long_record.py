@@ -105,13 +105,17 @@ def gather(parts: list[Trace]) -> Trace:
 class _Joined:
     """A record's trace filled piece by piece as the pieces arrive (one copy in memory).
 
-    ``trace``: the record's trace in shared memory, which the workers of this machine
-    write themselves (:class:`.shared_rows.SharedRows`); else made from the first piece.
+    ``shared``: the record's trace in shared memory, which the workers of this machine
+    write themselves (:class:`.shared_rows.SharedRows` and the client's map of it); else
+    the trace is made from the first piece.
     """
 
-    def __init__(self, total: int, trace: Trace | None = None) -> None:
+    def __init__(self, total: int, shared: tuple[SharedRows, Trace] | None = None) -> None:
         self.total = total
-        self.trace = trace
+        self.shared: SharedRows | None = None
+        self.trace: Trace | None = None
+        if shared is not None:
+            self.shared, self.trace = shared
         self.done = 0
         self.levels: list[np.ndarray] = []
 
@@ -123,6 +127,8 @@ class _Joined:
             return
         if self.trace is None:
             self.trace = Trace.allocate(part, self.total)
+        elif self.shared is not None:  # sent by a worker that does not see the file
+            self.shared.reserve((self.done, self.done + len(part)))
         self.done = self.trace.put(self.done, part)
         self.levels.append(part.meta["window_level"])
 
@@ -214,8 +220,8 @@ def run_long(
             return short.result()
         total = plan.layout.updates(n_raw)
         made = SharedRows.create(plan.state().empty_trace(), total)
-        shared, trace = made if made is not None else (None, None)
-        joined = _Joined(total, trace)
+        shared = made[0] if made is not None else None
+        joined = _Joined(total, made)
         try:
             finish = (finish_piece, (shared,))
             _, peaks = run_pieces(dask, plan, record, piece_samples, finish, joined.add, shared)

@@ -219,7 +219,8 @@ def solve_piece(
     samples = _kept(both, plan.layout, piece)
     st = plan.state()
     setup = st.kernel_setup()
-    whole = shared.open(st.empty_trace()) if shared is not None else None
+    rows = (piece.j_lo - 1, piece.j_hi)
+    whole = shared.open(st.empty_trace(), rows) if shared is not None else None
     if whole is None:
         trace = Trace.allocate(st.empty_trace(), piece.updates)
     else:  # rows of the shared trace (its own meta: the levels go back with the finish)
@@ -296,9 +297,10 @@ def finish_piece(
     """
     todo = settle(solved, plan, state)
     trace = solved.trace
-    whole = shared.open(trace) if shared is not None and solved.shared else None
+    start = solved.piece.j_lo - 1
+    rows = (start, start + todo)
+    whole = shared.open(trace, rows) if shared is not None and solved.shared else None
     if whole is None:
         return trace
-    start = solved.piece.j_lo - 1
     whole.put(start, trace.take(slice(0, todo)))
     return RowsInPlace(start, len(trace), trace.meta.get("window_level"))

@@ -4,12 +4,13 @@
 update, as :meth:`clpc.CLPC.run` does. Sent piece by piece, those rows cost the workers
 their sending and the client receiving them, decoding them and copying them into the
 record's trace, on the cores the workers need. So the client lays the record's trace
-arrays out in one file of ``/dev/shm`` (a tmpfs: memory, not disk; the space reserved up
-front with ``posix_fallocate``, so a full tmpfs is refused there rather than faulting
-later) and maps it (:meth:`SharedRows.create`); a worker that sees the file, which only a
-process of the same machine can, maps it too (:meth:`SharedRows.open`) and its kernel
-writes the piece's rows straight into it. The file is removed when the record is done;
-the client's map, and so its trace, stays until the trace is let go.
+arrays out in one file of ``/dev/shm`` (a tmpfs: memory, not disk) and maps it
+(:meth:`SharedRows.create`); a worker that sees the file, which only a process of the same
+machine can, maps it too (:meth:`SharedRows.open`), reserves its piece's rows with
+``posix_fallocate`` (so that a full tmpfs is refused there, not met by a write that would
+kill the process; the workers do it in parallel, the client does not zero the whole file
+first) and its kernel writes the piece's rows straight into it. The file is removed when
+the record is done; the client's map, and so its trace, stays until the trace is let go.
 
 A worker that does not see the file (another machine, or a container with its own
 ``/dev/shm``) solves into its own arrays and sends the rows, as it would without this.
@@ -96,23 +97,28 @@ class SharedRows:
     ) -> tuple[SharedRows, Trace] | None:
         """Make the shared file of a trace of ``rows`` updates shaped like ``like``, and map it.
 
-        ``folder``: where (default :data:`SHM`).
+        ``folder``: where (default :data:`SHM`). The file is sized but not filled: each
+        writer reserves the rows it writes (:meth:`reserve`), in parallel.
 
         Returns
         -------
         (SharedRows, Trace) or None
             The layout for the workers and the client's trace over the file; ``None`` when
-            ``folder`` is missing or has no room (the rows are then sent).
+            ``folder`` is missing or has not twice the room (the rows are then sent).
         """
         plan = _Views()
         Trace.allocate(like, rows, empty=plan)
-        path = (SHM if folder is None else folder) / f"clpc-trace-{uuid.uuid4().hex}"
+        where = SHM if folder is None else folder
         try:
+            room = os.statvfs(where)
+            if room.f_bavail * room.f_frsize < 2 * plan.size:
+                return None
+            path = where / f"clpc-trace-{uuid.uuid4().hex}"
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o600)
         except OSError:
             return None
         try:
-            os.posix_fallocate(fd, 0, plan.size)
+            os.ftruncate(fd, plan.size)
             buf = mmap.mmap(fd, plan.size)
         except OSError:
             path.unlink(missing_ok=True)
@@ -122,23 +128,55 @@ class SharedRows:
         shared = cls(str(path), rows, tuple(plan.slots), plan.size)
         return shared, Trace.allocate(like, rows, empty=_Views(buf, shared.slots))
 
-    def open(self, like: Trace) -> Trace | None:
-        """The trace over the shared file, mapped in this process (``None``: it is not seen).
+    def open(self, like: Trace, rows: tuple[int, int]) -> Trace | None:
+        """The trace over the shared file, mapped in this process, rows ``rows`` reserved.
 
-        ``like``: a trace of the record's appraiser. The arrays are views of a map of the
-        file, kept as long as they are.
+        ``like``: a trace of the record's appraiser; ``rows = (start, stop)``: the rows
+        this process will write. The arrays are views of a map of the file, kept as long
+        as they are. ``None``: this process does not see the file, or there is no room for
+        the rows (a write to an unreserved page of a full tmpfs would kill the process).
         """
         try:
             fd = os.open(self.path, os.O_RDWR)
         except OSError:
             return None
         try:
-            if os.fstat(fd).st_size != self.size:
+            if os.fstat(fd).st_size != self.size or not self._reserve(fd, rows):
                 return None
             buf = mmap.mmap(fd, self.size)
         finally:
             os.close(fd)
         return Trace.allocate(like, self.rows, empty=_Views(buf, self.slots))
+
+    def reserve(self, rows: tuple[int, int]) -> None:
+        """Reserve rows ``rows = (start, stop)`` for writing through an existing map.
+
+        Raises
+        ------
+        OSError
+            No room left for them (the message names the file and the bytes).
+        """
+        fd = os.open(self.path, os.O_RDWR)
+        try:
+            if not self._reserve(fd, rows):
+                raise OSError(
+                    f"{self.path}: no room in its tmpfs for rows {rows[0]}-{rows[1]} of the "
+                    "trace; free memory in /dev/shm (or run without the shared trace)."
+                )
+        finally:
+            os.close(fd)
+
+    def _reserve(self, fd: int, rows: tuple[int, int]) -> bool:
+        """Allocate the pages of rows ``rows`` of every array (False: no room)."""
+        try:
+            for shape, kind, offset in self.slots:
+                per_row = math.prod(shape[1:]) * np.dtype(kind).itemsize
+                lo, hi = offset + rows[0] * per_row, offset + rows[1] * per_row
+                if hi > lo:
+                    os.posix_fallocate(fd, lo, hi - lo)
+        except OSError:
+            return False
+        return True
 
     def remove(self) -> None:
         """Remove the file (the maps stay valid until their arrays are let go)."""
