@@ -33,11 +33,14 @@ def test_a_pieces_numbers_cross_an_event_exactly():
         rng.standard_normal((2, 3)),
         (theta, np.array([5e-324, -1.0]), np.array([True, False])),
         np.array([False, True]),
+        np.array([-1, 7]),
+        True,
     )
     msg = msgpack.unpackb(msgpack.packb(schedule._plain(info)))  # as Dask sends an event
     back = schedule._unplain(msg)
-    for have, want in [(back.peaks, info.peaks), (back.accepted, info.accepted),
-                       *zip(back.end, info.end, strict=True)]:  # fmt: skip
+    assert back.shared is True
+    pairs = [(back.peaks, info.peaks), (back.accepted, info.accepted), (back.first, info.first)]
+    for have, want in [*pairs, *zip(back.end, info.end, strict=True)]:
         assert have.dtype == want.dtype and have.shape == want.shape
         assert have.tobytes() == want.tobytes()  # bit for bit (-0.0 and subnormals too)
 

@@ -8,7 +8,6 @@ trace equals ``CLPC.run``'s bit for bit; the reference is the single-process run
 from __future__ import annotations
 
 import os
-import pickle
 
 import numpy as np
 import pytest
@@ -20,7 +19,6 @@ from clpc import CLPC
 from clpc.distributed import dask_client, run_long, shared_rows
 from clpc.distributed.long_record import plan_record
 from clpc.distributed.piece_tasks import (
-    RowsInPlace,
     finish_piece,
     next_state,
     piece_info,
@@ -60,35 +58,41 @@ def _pieces(n, settings, piece_samples):
 
 
 @needs_shm
-@pytest.mark.parametrize("moved", [False, True])
-def test_pieces_solved_into_the_shared_trace_give_the_single_process_trace(moved):
-    # in this process: the pieces' kernels write into the file; with ``moved`` every solved
-    # piece is pickled and unpickled first (a copy, as Dask moves it to another worker),
-    # so the finish must write the rows it settles itself
+@pytest.mark.parametrize("seen", [(True,), (True, False)])
+def test_pieces_in_the_shared_trace_settled_by_the_client_give_the_single_process_trace(seen):
+    # in this process: the pieces' kernels write into the file and the client settles them
+    # in its own map; with (True, False) every other piece is solved by a process that
+    # does not see the file and its rows are sent (put into the map by the client)
+    from clpc.distributed.long_record import _Joined
+
     n, settings = 12_011, {"window_size": 60, "cluster_size": 6}
     u, y = _record(n)
     ref = CLPC(**settings).run(u, y)
     held = ref.has_model & ~ref.accepted
     assert held[(ref.index > 3_500) & (ref.index < 6_500)].all()  # held across pieces
     plan, pieces = _pieces(n, settings, 2_000)
-    made = SharedRows.create(plan.state().empty_trace(), len(ref))
+    made = SharedRows.create(plan.state().empty_trace(), len(ref), ((1,), (1,)))
     assert made is not None
-    shared, trace = made
+    shared = made[0]
+    blind = SharedRows(shared.path + "-elsewhere", shared.rows, shared.slots, shared.size)
+    joined = _Joined(plan, made)
     try:
         state = plan.initial()
-        for piece in pieces:
+        for piece, sees in zip(pieces, seen * len(pieces), strict=False):
             lo, hi = piece.raw
-            solved = solve_piece((u[lo:hi], y[lo:hi]), plan, piece, shared)
-            assert solved.shared
-            if moved:
-                solved = pickle.loads(pickle.dumps(solved))
-            done = finish_piece(solved, plan, state, shared)
-            assert isinstance(done, RowsInPlace) and done.start == piece.j_lo - 1
-            state = next_state(state, piece_info(solved))
+            solved = solve_piece((u[lo:hi], y[lo:hi]), plan, piece, shared if sees else blind)
+            info = piece_info(solved)
+            assert solved.shared == info.shared == sees
+            part = joined.settle(piece, info, state) if sees else finish_piece(solved, plan, state)
+            joined.add(part)
+            state = next_state(state, info)
     finally:
         shared.remove()
-    assert not (shared_rows.SHM / shared.path.split("/")[-1]).exists()
-    _assert_equal(ref, trace)  # the client's map still holds the rows
+    assert not os.path.exists(shared.path)
+    got = joined.result()  # the client's map still holds the rows
+    _assert_equal(ref, got)
+    levels = (got.meta["window_level"], ref.meta["window_level"])
+    np.testing.assert_allclose(*levels, rtol=1e-12, atol=1e-13)
 
 
 def test_a_process_that_does_not_see_the_file_sends_its_rows(tmp_path):
@@ -96,17 +100,17 @@ def test_a_process_that_does_not_see_the_file_sends_its_rows(tmp_path):
     u, y = _record(n)
     ref = CLPC(**settings).run(u, y)
     plan, pieces = _pieces(n, settings, 3_000)
-    made = SharedRows.create(plan.state().empty_trace(), len(ref), folder=tmp_path)
+    like = plan.state().empty_trace()
+    made = SharedRows.create(like, len(ref), ((1,), (1,)), folder=tmp_path)
     assert made is not None
     shared = SharedRows(str(tmp_path / "elsewhere"), *(made[0].rows, made[0].slots, made[0].size))
     state, parts = plan.initial(), []
     for piece in pieces:
         lo, hi = piece.raw
         solved = solve_piece((u[lo:hi], y[lo:hi]), plan, piece, shared)
-        assert not solved.shared
-        parts.append(finish_piece(solved, plan, state, shared))
+        assert not solved.shared and not piece_info(solved).shared
+        parts.append(finish_piece(solved, plan, state))
         state = next_state(state, piece_info(solved))
-    assert all(not isinstance(p, RowsInPlace) for p in parts)
     from clpc.appraiser.trace import Trace
 
     _assert_equal(ref, Trace.concat(parts))
@@ -146,18 +150,22 @@ def test_run_long_is_clpc_run_with_or_without_shared_memory(client, monkeypatch,
 def test_the_file_is_sparse_until_a_writer_reserves_its_rows(monkeypatch):
     plan, _ = _pieces(12_011, {"window_size": 60, "cluster_size": 6}, 2_000)
     like = plan.state().empty_trace()
-    shared, trace = SharedRows.create(like, 2_000)
+    shared, mapped = SharedRows.create(like, 2_000, ((1,),))
+    trace = mapped.trace
     try:
         assert os.stat(shared.path).st_blocks == 0  # the client zeroes nothing
-        whole = shared.open(like, (0, 1_000))
-        assert whole is not None
-        per_row = sum(a.nbytes for a in _arrays(trace).values()) // len(trace)
+        other = shared.open(like, (0, 1_000))
+        assert other is not None
+        per_row = sum(a.nbytes for a in _arrays(trace).values()) // len(trace) + 8
         assert os.stat(shared.path).st_blocks * 512 >= 1_000 * per_row
-        whole.arrays["theta"][:1_000] = 1.5  # seen through the client's map
-        assert np.all(trace.arrays["theta"][:1_000] == 1.5)
+        other.trace.arrays["theta"][:1_000] = 1.5  # seen through the client's map
+        other.extra[0][:1_000] = 2.5
+        assert np.all(trace.arrays["theta"][:1_000] == 1.5) and np.all(
+            mapped.extra[0][:1_000] == 2.5
+        )
     finally:
         shared.remove()
     # a tmpfs without twice the room: no shared trace (the rows are then sent)
     small = os.statvfs_result((4096, 4096, 10, 1, 1, 10, 1, 1, 0, 255))
     monkeypatch.setattr(shared_rows.os, "statvfs", lambda path: small)
-    assert SharedRows.create(like, 2_000) is None
+    assert SharedRows.create(like, 2_000, ((1,),)) is None

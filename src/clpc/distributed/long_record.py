@@ -17,7 +17,7 @@ numbers agree to rounding (``docs/distributed-long.md``).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -27,10 +27,10 @@ from clpc.appraiser.trace import Trace
 from clpc.data import DataError
 from clpc.data.samples import check_ranges
 from clpc.distributed.cluster import dask_client
-from clpc.distributed.piece_tasks import RecordPlan, RowsInPlace, finish_piece
-from clpc.distributed.pieces import Layout
+from clpc.distributed.piece_tasks import FsmTuple, PieceInfo, RecordPlan, SolvedPiece, settle
+from clpc.distributed.pieces import Layout, Piece
 from clpc.distributed.schedule import run_pieces
-from clpc.distributed.shared_rows import SharedRows
+from clpc.distributed.shared_rows import Mapped, SharedRows
 from clpc.distributed.sources import NpySource, ParquetSource
 
 __all__ = [
@@ -102,39 +102,65 @@ def gather(parts: list[Trace]) -> Trace:
     return trace
 
 
+class _InPlace(NamedTuple):
+    """A piece settled by the client in the shared trace."""
+
+    start: int  #: its first row
+    n_rows: int  #: its rows
+
+
 class _Joined:
     """A record's trace filled piece by piece as the pieces arrive (one copy in memory).
 
     ``shared``: the record's trace in shared memory, which the workers of this machine
-    write themselves (:class:`.shared_rows.SharedRows` and the client's map of it); else
-    the trace is made from the first piece.
+    write themselves, with each window's own ``c`` and level as extra arrays
+    (:class:`.shared_rows.SharedRows` and the client's map of it); else the trace is made
+    from the first piece sent.
     """
 
-    def __init__(self, total: int, shared: tuple[SharedRows, Trace] | None = None) -> None:
-        self.total = total
+    def __init__(self, plan: RecordPlan, shared: tuple[SharedRows, Mapped] | None) -> None:
+        self.plan = plan
+        self.total = plan.layout.updates(plan.n_raw)
         self.shared: SharedRows | None = None
+        self.mapped: Mapped | None = None
         self.trace: Trace | None = None
         if shared is not None:
-            self.shared, self.trace = shared
+            self.shared, self.mapped = shared
+            self.trace = self.mapped.trace
         self.done = 0
         self.levels: list[np.ndarray] = []
 
-    def add(self, part: Trace | RowsInPlace) -> None:
-        if isinstance(part, RowsInPlace):  # written by the worker
-            assert part.start == self.done and part.levels is not None, part.start
+    def settle(self, piece: Piece, info: PieceInfo, state: FsmTuple) -> _InPlace:
+        """Finish a piece the workers wrote into the shared trace (in this process's map)."""
+        assert self.mapped is not None
+        lo, hi = piece.j_lo - 1, piece.j_hi
+        c = self.mapped.extra[0][lo:hi]
+        here = SolvedPiece(piece, self.mapped.trace.view(lo, hi), c, info.first, info.peaks, True)
+        settle(here, self.plan, state)
+        return _InPlace(lo, hi - lo)
+
+    def add(self, part: Trace | _InPlace) -> None:
+        if isinstance(part, _InPlace):
+            assert part.start == self.done, (part.start, self.done)
             self.done += part.n_rows
-            self.levels.append(part.levels)
             return
+        start, stop = self.done, self.done + len(part)
         if self.trace is None:
             self.trace = Trace.allocate(part, self.total)
         elif self.shared is not None:  # sent by a worker that does not see the file
-            self.shared.reserve((self.done, self.done + len(part)))
-        self.done = self.trace.put(self.done, part)
-        self.levels.append(part.meta["window_level"])
+            self.shared.reserve((start, stop))
+        self.done = self.trace.put(start, part)
+        if self.mapped is not None:
+            self.mapped.extra[1][start:stop] = part.meta["window_level"]
+        else:
+            self.levels.append(part.meta["window_level"])
 
     def result(self) -> Trace:
         assert self.trace is not None and self.done == self.total, (self.done, self.total)
-        self.trace.meta["window_level"] = np.concatenate(self.levels)
+        if self.mapped is not None:
+            self.trace.meta["window_level"] = self.mapped.extra[1]
+        else:
+            self.trace.meta["window_level"] = np.concatenate(self.levels)
         return self.trace
 
 
@@ -218,13 +244,16 @@ def run_long(
             config = appraiser.config()
             short = dask.submit(_short_record, config, raw, channels[0], dt, pure=False)
             return short.result()
-        total = plan.layout.updates(n_raw)
-        made = SharedRows.create(plan.state().empty_trace(), total)
+        # the extra arrays: each window's own c and level, per output
+        extra = ((channels[1],), (channels[1],))
+        made = SharedRows.create(plan.state().empty_trace(), plan.layout.updates(n_raw), extra)
         shared = made[0] if made is not None else None
-        joined = _Joined(total, made)
+        joined = _Joined(plan, made)
         try:
-            finish = (finish_piece, (shared,))
-            _, peaks = run_pieces(dask, plan, record, piece_samples, finish, joined.add, shared)
+            _, peaks = run_pieces(
+                dask, plan, record, piece_samples, sink=joined.add, shared=shared,
+                local=joined.settle,
+            )  # fmt: skip
         finally:
             if shared is not None:
                 shared.remove()

@@ -1,26 +1,27 @@
 """What a worker does with one piece of a long record (see :mod:`clpc.distributed.pieces`).
 
-Two tasks per piece, functions of picklable arguments, both run in parallel:
+Two steps per piece, functions of picklable arguments:
 
 1. :func:`solve_piece`: read the piece's raw samples (from the file, or the slice of a
    ``dask.array`` computed on a worker), check them as :meth:`clpc.CLPC.push` does,
-   decimate, solve every window with the kernel's stateless solve
-   (:func:`clpc.appraiser.kernel.solve`), and run the finite-state machine's output
-   (:func:`clpc.appraiser.kernel.output`) over them from "no model yet". That output is
-   already the record's from each equation's first accepted update of the piece on: an
+   decimate, and solve every window and run the finite-state machine's output over them
+   from "no model yet", in one pass of the kernel (:func:`clpc.appraiser.kernel.solve_updates`,
+   as :meth:`clpc.CLPC.run` runs it) straight into the piece's trace rows (its own arrays,
+   or the rows of the record's trace in shared memory, :mod:`.shared_rows`). That output
+   is already the record's from each equation's first accepted update of the piece on: an
    accepted update replaces the whole carried state (the held theta, c and the has-a-model
    flag), so nothing before it is seen after it. :func:`piece_info` is the few numbers the
-   client needs (:class:`PieceInfo`): the channels' extremes, the state the piece ends in
-   and which equations accepted an update in it;
-2. :func:`finish_piece` / :func:`write_piece`: given the state the record's FSM is in when
-   the piece starts (:func:`next_state` of the pieces before, computed on the client),
-   :func:`settle` runs the FSM again over the piece's first updates, up to each equation's
-   first accepted one (usually a handful), from that state; then the piece's trace rows are
-   returned, or written by the worker to one file of a Parquet dataset with only what a
-   summary and a report need returned.
+   client needs (:class:`PieceInfo`): the channels' extremes, the state the piece ends in,
+   which equations accepted an update in it and where first;
+2. :func:`settle`, given the state the record's FSM is in when the piece starts
+   (:func:`next_state` of the pieces before, computed on the client), runs the FSM again
+   over the piece's first updates, up to each equation's first accepted one (usually a
+   handful), from that state, in place: on the worker that holds the piece
+   (:func:`finish_piece`, the rows then returned, or :func:`.part_file.write_piece`), or on
+   the client in its map of the shared trace.
 
-No task waits for another piece's task, and only the FSM state (a few numbers per output)
-goes from the client to a worker.
+No step waits for another piece's, and only the FSM state (a few numbers per output) goes
+from the client to a worker.
 """
 
 from __future__ import annotations
@@ -43,7 +44,6 @@ from clpc.distributed.shared_rows import SharedRows
 __all__ = [
     "PieceInfo",
     "RecordPlan",
-    "RowsInPlace",
     "SolvedPiece",
     "finish_piece",
     "next_state",
@@ -121,15 +121,7 @@ class SolvedPiece(NamedTuple):
     solved_c: np.ndarray  #: (count, E): each window's own ``c`` (not a trace column)
     first_accepted: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
-    shared: bool  #: the kernel wrote ``trace`` into the record's shared trace (SharedRows)
-
-
-class RowsInPlace(NamedTuple):
-    """What a finish returns when the piece's rows are in the record's shared trace."""
-
-    start: int  #: the piece's first row in the record's trace
-    n_rows: int  #: its rows
-    levels: np.ndarray | None  #: (count, n_out): its windows' levels, if computed
+    shared: bool  #: ``trace`` and ``solved_c`` are views of the record's shared trace
 
 
 try:  # Dask's memory accounting sizes a returned trace or solved piece by its arrays
@@ -150,6 +142,8 @@ class PieceInfo(NamedTuple):
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum
     end: FsmTuple  #: the FSM state after the piece, for the equations that accepted in it
     accepted: np.ndarray  #: (E,) bool: the equation accepted an update in the piece
+    first: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
+    shared: bool  #: the rows are in the record's shared trace (SolvedPiece.shared)
 
 
 def _kept(raw: np.ndarray, layout: Layout, piece: Piece) -> np.ndarray:
@@ -201,8 +195,9 @@ def solve_piece(
     plan : RecordPlan
     piece : Piece
     shared : SharedRows, optional
-        The record's trace in shared memory: when this process sees it, the kernel writes
-        the piece's rows there (else into the piece's own arrays).
+        The record's trace in shared memory (with two extra arrays: each window's own
+        ``c`` and level): when this process sees it, the kernel writes the piece's rows
+        there (else into the piece's own arrays), and the client settles them itself.
 
     Raises
     ------
@@ -219,14 +214,16 @@ def solve_piece(
     samples = _kept(both, plan.layout, piece)
     st = plan.state()
     setup = st.kernel_setup()
-    rows = (piece.j_lo - 1, piece.j_hi)
-    whole = shared.open(st.empty_trace(), rows) if shared is not None else None
-    if whole is None:
+    lo, hi = piece.j_lo - 1, piece.j_hi
+    mapped = shared.open(st.empty_trace(), (lo, hi)) if shared is not None else None
+    if mapped is None:
         trace = Trace.allocate(st.empty_trace(), piece.updates)
-    else:  # rows of the shared trace (its own meta: the levels go back with the finish)
-        view = whole.view(piece.j_lo - 1, piece.j_hi)
+        dest = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+    else:  # rows of the shared trace; the windows' own c in its first extra array
+        view = mapped.trace.view(lo, hi)
         trace = dataclasses.replace(view, meta=dict(view.meta))
-    dest = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+        windows, out = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+        dest = (tuple(kernel.Solved(*windows)._replace(c=mapped.extra[0][lo:hi])), out)
     cache = kernel.new_cache(setup.plan.chan.shape, kernel.cache_blocks(setup.plan))
     first_row = piece.kept[0] - plan.layout.max_lag
     fsm = kernel.FsmState(*plan.initial())
@@ -238,15 +235,18 @@ def solve_piece(
     first = np.where(accepted.any(axis=0), accepted.argmax(axis=0), -1)
     if plan.levels:
         trace.meta["window_level"] = _levels(y, plan, piece, trace.rows)
+        if mapped is not None:  # the second extra array
+            mapped.extra[1][lo:hi] = trace.meta["window_level"]
     peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
-    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks, whole is not None)
+    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks, mapped is not None)
 
 
 def piece_info(solved: SolvedPiece) -> PieceInfo:
     """The extremes and the end state of a solved piece (see :func:`next_state`)."""
     arrays = solved.trace.arrays
     end = (arrays["theta"][-1].copy(), arrays["c"][-1].copy(), arrays["has_model"][-1].copy())
-    return PieceInfo(solved.peaks, end, solved.first_accepted >= 0)
+    first = solved.first_accepted
+    return PieceInfo(solved.peaks, end, first >= 0, first.copy(), solved.shared)
 
 
 def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
@@ -284,23 +284,10 @@ def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> int:
     return todo
 
 
-def finish_piece(
-    solved: SolvedPiece, plan: RecordPlan, state: FsmTuple, shared: SharedRows | None = None
-) -> Trace | RowsInPlace:
+def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
     """The piece's trace rows (what :meth:`clpc.CLPC.run` returns for these updates).
 
-    ``state``: the record's FSM state before the piece (:func:`next_state`). With
-    ``shared``, when the piece was solved into the record's shared trace and this process
-    sees it: the settled rows are written there and only :class:`RowsInPlace` returned
-    (the rows settled are written again, as ``solved`` may be a copy moved from another
-    worker of this machine).
+    ``state``: the record's FSM state before the piece (:func:`next_state`).
     """
-    todo = settle(solved, plan, state)
-    trace = solved.trace
-    start = solved.piece.j_lo - 1
-    rows = (start, start + todo)
-    whole = shared.open(trace, rows) if shared is not None and solved.shared else None
-    if whole is None:
-        return trace
-    whole.put(start, trace.take(slice(0, todo)))
-    return RowsInPlace(start, len(trace), trace.meta.get("window_level"))
+    settle(solved, plan, state)
+    return solved.trace

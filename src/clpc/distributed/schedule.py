@@ -83,6 +83,7 @@ def run_pieces(
     finish: tuple[Callable[..., Any], tuple[Any, ...]] = (finish_piece, ()),
     sink: Callable[[Any], None] | None = None,
     shared: Any = None,
+    local: Callable[[Piece, PieceInfo, Any], Any] | None = None,
 ) -> tuple[list[Any], np.ndarray]:
     """Run every piece of a record on ``client``.
 
@@ -103,6 +104,9 @@ def run_pieces(
     shared : SharedRows, optional
         The record's trace in shared memory, for the solves
         (:func:`.piece_tasks.solve_piece`).
+    local : callable, optional
+        ``local(piece, info, state)``: the finish of a piece whose rows are in the shared
+        trace (``info.shared``), done by the client itself in its map of it (no task).
 
     Returns
     -------
@@ -152,8 +156,11 @@ def run_pieces(
                                   np.minimum(peaks[1], part.peaks[1])])  # fmt: skip
             while after in solved:  # in time order: the record's state before each piece
                 fut, part, where = solved.pop(after)
-                finishing.append(_finish(client, fut, (plan, state, where), finish))
-                finishing[-1].add_done_callback(news.wake_up)
+                if local is not None and part.shared:  # the rows are in the shared trace
+                    finishing.append(_Done(local(pieces[after], part, state)))
+                else:
+                    finishing.append(_finish(client, fut, (plan, state, where), finish))
+                    finishing[-1].add_done_callback(news.wake_up)
                 state = next_state(state, part)
                 after += 1
             if finishing and finishing[0].done():
@@ -163,6 +170,19 @@ def run_pieces(
     finally:
         client.unsubscribe_topic(news.topic)
     return results, peaks
+
+
+class _Done:
+    """A finish done by the client: a future already done."""
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
+
+    def done(self) -> bool:
+        return True
+
+    def result(self) -> Any:
+        return self.value
 
 
 def _on(where: str | None) -> dict[str, Any]:
@@ -219,6 +239,8 @@ def _plain(info: PieceInfo) -> dict[str, Any]:
         "peaks": info.peaks.tolist(),
         "end": [theta.tolist(), c.tolist(), has_model.tolist()],
         "accepted": info.accepted.tolist(),
+        "first": info.first.tolist(),
+        "shared": bool(info.shared),
     }
 
 
@@ -228,7 +250,8 @@ def _unplain(msg: dict[str, Any]) -> PieceInfo:
     end = (np.array(theta, dtype=np.float64), np.array(c, dtype=np.float64),
            np.array(has_model, dtype=bool))  # fmt: skip
     peaks = np.array(msg["peaks"], dtype=np.float64)
-    return PieceInfo(peaks, end, np.array(msg["accepted"], dtype=bool))
+    first = np.array(msg["first"], dtype=np.int64)
+    return PieceInfo(peaks, end, np.array(msg["accepted"], dtype=bool), first, msg["shared"])
 
 
 def _finish(

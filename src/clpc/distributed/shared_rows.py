@@ -12,6 +12,12 @@ kill the process; the workers do it in parallel, the client does not zero the wh
 first) and its kernel writes the piece's rows straight into it. The file is removed when
 the record is done; the client's map, and so its trace, stays until the trace is let go.
 
+Two extra arrays lie beside the trace's (``extra`` of :meth:`SharedRows.create`: for
+``run_long``, each window's own ``c`` and its level): with them in the file, the client
+itself settles a piece's first updates in its map once it knows the record's state before
+the piece (:func:`clpc.distributed.piece_tasks.settle`), so nothing of the piece but its
+few numbers is sent, and no finish task is needed.
+
 A worker that does not see the file (another machine, or a container with its own
 ``/dev/shm``) solves into its own arrays and sends the rows, as it would without this.
 """
@@ -24,13 +30,13 @@ import os
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from clpc.appraiser.trace import Trace
 
-__all__ = ["SHM", "SharedRows"]
+__all__ = ["SHM", "Mapped", "SharedRows"]
 
 #: the tmpfs the shared trace is made in
 SHM = Path("/dev/shm")
@@ -69,6 +75,13 @@ class _Views:
         return np.frombuffer(self.buf, kind, count=count, offset=slot[2]).reshape(shape)
 
 
+class Mapped(NamedTuple):
+    """A process's map of the shared file: the trace and the extra per-update arrays."""
+
+    trace: Trace
+    extra: list[np.ndarray]  #: (rows, ...) float64 each, as laid out by ``extra`` of create
+
+
 @dataclass(frozen=True)
 class SharedRows:
     """Where a record's trace lies in a shared file (small and picklable).
@@ -81,7 +94,7 @@ class SharedRows:
         Updates of the record.
     slots : tuple
         ``(shape, dtype, offset)`` of every array, in the order :meth:`Trace.allocate`
-        makes them.
+        makes them, then the extra arrays.
     size : int
         Bytes of the file.
     """
@@ -93,21 +106,29 @@ class SharedRows:
 
     @classmethod
     def create(
-        cls, like: Trace, rows: int, folder: Path | None = None
-    ) -> tuple[SharedRows, Trace] | None:
+        cls,
+        like: Trace,
+        rows: int,
+        extra: tuple[tuple[int, ...], ...] = (),
+        folder: Path | None = None,
+    ) -> tuple[SharedRows, Mapped] | None:
         """Make the shared file of a trace of ``rows`` updates shaped like ``like``, and map it.
 
-        ``folder``: where (default :data:`SHM`). The file is sized but not filled: each
-        writer reserves the rows it writes (:meth:`reserve`), in parallel.
+        ``extra``: the row shapes of float64 arrays laid out after the trace's (per-update
+        numbers that are not trace columns). ``folder``: where (default :data:`SHM`). The
+        file is sized but not filled: each writer reserves the rows it writes
+        (:meth:`reserve`), in parallel.
 
         Returns
         -------
-        (SharedRows, Trace) or None
-            The layout for the workers and the client's trace over the file; ``None`` when
+        (SharedRows, Mapped) or None
+            The layout for the workers and the client's map of the file; ``None`` when
             ``folder`` is missing or has not twice the room (the rows are then sent).
         """
         plan = _Views()
         Trace.allocate(like, rows, empty=plan)
+        for shape in extra:
+            plan((rows, *shape), np.float64)
         where = SHM if folder is None else folder
         try:
             room = os.statvfs(where)
@@ -126,10 +147,16 @@ class SharedRows:
         finally:
             os.close(fd)
         shared = cls(str(path), rows, tuple(plan.slots), plan.size)
-        return shared, Trace.allocate(like, rows, empty=_Views(buf, shared.slots))
+        return shared, shared._mapped(like, buf)
 
-    def open(self, like: Trace, rows: tuple[int, int]) -> Trace | None:
-        """The trace over the shared file, mapped in this process, rows ``rows`` reserved.
+    def _mapped(self, like: Trace, buf: mmap.mmap) -> Mapped:
+        views = _Views(buf, self.slots)
+        trace = Trace.allocate(like, self.rows, empty=views)
+        extra = [views(shape, kind) for shape, kind, _ in self.slots[len(views.slots) :]]
+        return Mapped(trace, extra)
+
+    def open(self, like: Trace, rows: tuple[int, int]) -> Mapped | None:
+        """The shared file mapped in this process, rows ``rows`` reserved.
 
         ``like``: a trace of the record's appraiser; ``rows = (start, stop)``: the rows
         this process will write. The arrays are views of a map of the file, kept as long
@@ -146,7 +173,7 @@ class SharedRows:
             buf = mmap.mmap(fd, self.size)
         finally:
             os.close(fd)
-        return Trace.allocate(like, self.rows, empty=_Views(buf, self.slots))
+        return self._mapped(like, buf)
 
     def reserve(self, rows: tuple[int, int]) -> None:
         """Reserve rows ``rows = (start, stop)`` for writing through an existing map.
