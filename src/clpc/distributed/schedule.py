@@ -115,7 +115,7 @@ def run_pieces(
     peaks : ndarray, shape (2, channels)
         The maximum and the minimum of every raw channel of the record.
     """
-    require_distributed()
+    distributed = require_distributed()
     addresses = list(client.scheduler_info().get("workers", {})) or [None]
     n_workers = len(addresses)
     size = piece_samples or default_piece_samples(plan, n_workers)
@@ -133,6 +133,7 @@ def run_pieces(
     solving: dict[int, tuple[Any, Any]] = {}  # piece number: (solved, info) futures
     solved: dict[int, tuple[Any, Any, Any]] = {}  # piece number: (future, PieceInfo, worker)
     finishing: deque[Any] = deque()  # in time order
+    ending: list[Any] = []  # solves whose event was heard, their tasks maybe not yet ended
     state: Any = plan.initial()
     after = 0  # the piece whose finish is submitted next (the record's state is before it)
     client.subscribe_topic(news.topic, news.hear)
@@ -158,15 +159,18 @@ def run_pieces(
                 fut, part, where = solved.pop(after)
                 if local is not None and part.shared:  # the rows are in the shared trace
                     finishing.append(_Done(local(pieces[after], part, state)))
+                    ending.append(fut)  # released once its task has ended
                 else:
                     finishing.append(_finish(client, fut, (plan, state, where), finish))
                     finishing[-1].add_done_callback(news.wake_up)
                 state = next_state(state, part)
                 after += 1
+            ending = [f for f in ending if not f.done()]
             if finishing and finishing[0].done():
                 take(finishing.popleft().result())
             elif solving or finishing:
                 news.wait()
+        distributed.wait(ending)  # every task of the record has ended
     finally:
         client.unsubscribe_topic(news.topic)
     return results, peaks
