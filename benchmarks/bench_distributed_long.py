@@ -9,7 +9,7 @@ measurement noise 0.02), ``--samples`` samples (default 1e7) written block by bl
 Runs, all in one invocation:
 
 * ``single``: ``CLPC().run(u, y)`` in a fresh subprocess (the record loaded into memory first,
-  not timed; the trace kept), best of ``--repeat``;
+  not timed; the trace kept);
 * ``run_long N``: :func:`clpc.distributed.run_long` on a ``LocalCluster`` of ``N`` worker
   processes (one thread each): the workers read their memory-mapped slices of the ``.npy``
   file; the trace's rows come back to this process (as ``run`` returns them);
@@ -29,7 +29,10 @@ kernel is loaded in each worker, the report's imports in this process), then tim
 ``run_long`` trace is compared with the single-process trace array by array (SHA-256 of
 every array: bit for bit).
 
-Each distributed run is repeated ``--repeat`` times and the fastest kept (as ``single``).
+Each distributed run is repeated ``--repeat`` times and the fastest kept; before each round
+of the distributed runs the two references run once each (in fresh processes), so that on
+a shared machine both sides meet the same load, and the fastest of all their runs is the
+reference.
 Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
 computing (summed over the task stream, by task: solve, piece info, finish); the CPU time
 of each worker process and of this process (the client and the local cluster's scheduler:
@@ -171,9 +174,13 @@ def _incoming_bytes(client: Any) -> int:
 
 
 def distributed_runs(
-    path: str, n_workers: int, reference: dict[str, Any], tmp: Path, repeat: int = 1
+    path: str, n_workers: int, tmp: Path, repeat: int = 1, between: Any = None
 ) -> list[dict[str, Any]]:
-    """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes."""
+    """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes.
+
+    ``between()``, if given, is called before each round of the modes (the references run
+    there, in turn with the distributed runs, so that both meet the same load).
+    """
     import distributed
 
     from clpc import CLPC
@@ -190,7 +197,9 @@ def distributed_runs(
             run_long(CLPC(), NpySource(str(warm), (0,), (1,)), client=client, piece_samples=10_000)
         # the report's imports in this process, as the single clpc track's warm-up does
         track_settings(track_settings_of(str(warm), tmp / "warm"), client=client)
-        for mode in [m for m in MODES for _ in range(repeat)]:
+        for mode in [m for _ in range(repeat) for m in MODES]:
+            if mode == MODES[0] and between is not None:
+                between()
             base = _incoming_bytes(client)
             rss0 = _peak_rss_mb()
             cpu0 = client.run(time.process_time)
@@ -216,7 +225,7 @@ def distributed_runs(
             worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
             equal = None
             if mode == "run_long":  # checked after the timing
-                equal = digests(trace) == reference["digests"]
+                equal = digests(trace)  # compared with the single process's in main
                 del trace
             seconds = _task_seconds(ts.data)
             pieces = sum(1 for t in ts.data if str(t["key"]).startswith("solve_piece"))
@@ -304,29 +313,36 @@ def main() -> None:
         took = time.perf_counter() - t0
         print(f"record: {n:.3g} samples, {path.stat().st_size / 1e6:.0f} MB ({took:.1f} s)")
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-        cmd = [sys.executable, __file__, "--single-worker", str(path), str(args.repeat)]
-        ref = json.loads(
-            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
-        )
-        cmd = [sys.executable, __file__, "--single-track", str(path), str(args.repeat)]
-        ref["track"] = json.loads(
-            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
-        )
+        singles: list[dict[str, Any]] = []
+        tracks: list[dict[str, Any]] = []
+
+        def references() -> None:  # one run of each, each in a fresh process
+            for flag, out in (("--single-worker", singles), ("--single-track", tracks)):
+                cmd = [sys.executable, __file__, flag, str(path), "1"]
+                done = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+                out.append(json.loads(done.stdout))
+
+        rows = {
+            w: distributed_runs(str(path), w, tmp, args.repeat, references) for w in args.workers
+        }
+        ref = min(singles, key=lambda r: r["wall"])
+        ref["track"] = track = min(tracks, key=lambda r: r["wall"])
         print(
             f"\nsingle      wall {ref['wall']:7.2f} s  cpu {ref['cpu']:7.2f} s  "
             f"{n / ref['wall']:10.3g} samples/s  {ref['updates']} updates  "
-            f"peak RSS added {ref['rss_added_mb']:.0f} MB"
+            f"peak RSS added {ref['rss_added_mb']:.0f} MB  (best of {len(singles)})"
         )
-        track = ref["track"]
         print(
             f"clpc track  wall {track['wall']:7.2f} s  cpu {track['cpu']:7.2f} s  "
             f"{n / track['wall']:10.3g} samples/s  {track['updates']} updates "
-            "(one process: Parquet trace file, summary, figures, report)"
+            f"(one process: Parquet trace file, summary, figures, report; best of {len(tracks)})"
         )
-        for w in args.workers:
-            rows = distributed_runs(str(path), w, ref, tmp, args.repeat)
+        for runs in rows.values():
+            for row in runs:
+                if row["mode"] == "run_long":
+                    row["equal"] = row["equal"] == ref["digests"]
             for mode in MODES:
-                _show(min((r for r in rows if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
+                _show(min((r for r in runs if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
     print(f"\nload average after: {os.getloadavg()}")
 
 
