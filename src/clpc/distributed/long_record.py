@@ -3,12 +3,15 @@
 The record is cut into pieces of consecutive updates (:mod:`clpc.distributed.pieces`). Per
 piece, a worker reads its samples (a memory-mapped ``.npy`` slice, Parquet row groups, or
 a slice of a ``dask.array`` computed on the workers: no sample passes through the client),
-solves its windows and runs the finite-state machine over them from "no model yet"; the
-client carries the FSM state from piece to piece (a few numbers each), and the worker
-redoes the piece's first updates, up to each equation's first accepted one, from that
-state (:mod:`.piece_tasks`); last, each piece's trace rows are built (returned, or written
-by the worker as one file of a Parquet dataset).
-Pieces in flight are bounded (:mod:`.schedule`), so memory stays O(piece).
+solves its windows and runs the finite-state machine over them from "no model yet",
+straight into the piece's trace rows; the client carries the FSM state from piece to piece
+(a few numbers each), and the piece's first updates, up to each equation's first accepted
+one, are run again from that state (:mod:`.piece_tasks`). On the client's machine the rows
+lie in the record's trace in shared memory (:mod:`.shared_rows`): the workers write them
+there and the client settles them in its map, so no rows are sent; a worker of another
+machine settles its piece and returns the rows (or, in :mod:`.long_track`, writes them as
+one file of a Parquet dataset). Pieces in flight are bounded (:mod:`.schedule`), so
+memory stays O(piece).
 
 The trace equals ``CLPC(...).run(u, y)`` bit for bit without decimation; with decimation
 each piece starts its anti-alias filter a warm-up earlier (:func:`.pieces.warmup`) and the
