@@ -95,6 +95,39 @@ def test_pieces_in_the_shared_trace_settled_by_the_client_give_the_single_proces
     np.testing.assert_allclose(*levels, rtol=1e-12, atol=1e-13)
 
 
+@needs_shm
+def test_a_second_run_of_a_piece_leaves_the_rows_the_client_settled():
+    # Dask re-runs a solve whose worker died, maybe after the client heard from the first
+    # run and settled its rows in place: the re-run must not write them again
+    from clpc.distributed.long_record import _Joined
+
+    n, settings = 12_011, {"window_size": 60, "cluster_size": 6}
+    u, y = _record(n)
+    ref = CLPC(**settings).run(u, y)
+    plan, pieces = _pieces(n, settings, 2_000)
+    made = SharedRows.create(plan.state().empty_trace(), len(ref), ((1,), (1,)))
+    assert made is not None
+    shared, joined, state = made[0], _Joined(plan, made), plan.initial()
+    held = [p for p in pieces if 3_500 < p.raw[0] < 6_000]  # starts holding an older model
+    assert held
+    try:
+        for piece in pieces:
+            lo, hi = piece.raw
+            solved = solve_piece((u[lo:hi], y[lo:hi]), plan, piece, shared)
+            assert solved.shared
+            joined.add(joined.settle(piece, piece_info(solved), state))
+            state = next_state(state, piece_info(solved))
+        for piece in held:  # the re-runs, after the client settled the pieces
+            lo, hi = piece.raw
+            again = solve_piece((u[lo:hi], y[lo:hi]), plan, piece, shared)
+            assert not again.shared  # solved into its own arrays
+            assert not again.trace.has_model[0].all()  # unsettled: would have undone the settle
+    finally:
+        shared.remove()
+    assert not list(shared_rows.SHM.glob(os.path.basename(shared.path) + "*"))
+    _assert_equal(ref, joined.result())
+
+
 def test_a_process_that_does_not_see_the_file_sends_its_rows(tmp_path):
     n, settings = 9_007, {"window_size": 60, "cluster_size": 6}
     u, y = _record(n)

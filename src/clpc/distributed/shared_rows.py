@@ -20,6 +20,11 @@ few numbers is sent, and no finish task is needed.
 
 A worker that does not see the file (another machine, or a container with its own
 ``/dev/shm``) solves into its own arrays and sends the rows, as it would without this.
+So does a second run of a piece (Dask re-runs a solve whose worker died, perhaps after the
+client heard from the first run and settled its rows): the first writer of a piece claims
+its rows with a file created exclusively beside the trace (:meth:`SharedRows.open`), and
+any later run of that piece solves into its own arrays, so rows the client may have
+settled are never written again.
 """
 
 from __future__ import annotations
@@ -161,14 +166,18 @@ class SharedRows:
         ``like``: a trace of the record's appraiser; ``rows = (start, stop)``: the rows
         this process will write. The arrays are views of a map of the file, kept as long
         as they are. ``None``: this process does not see the file, or there is no room for
-        the rows (a write to an unreserved page of a full tmpfs would kill the process).
+        the rows (a write to an unreserved page of a full tmpfs would kill the process),
+        or the rows were claimed before: another run of the same piece (a re-run of its
+        task) has written them, and the client may have settled them since.
         """
         try:
             fd = os.open(self.path, os.O_RDWR)
         except OSError:
             return None
         try:
-            if os.fstat(fd).st_size != self.size or not self._reserve(fd, rows):
+            if os.fstat(fd).st_size != self.size or not self._claimed(rows[0]):
+                return None
+            if not self._reserve(fd, rows):
                 return None
             buf = mmap.mmap(fd, self.size)
         finally:
@@ -205,6 +214,18 @@ class SharedRows:
             return False
         return True
 
+    def _claimed(self, row: int) -> bool:
+        """Claim the rows that start at ``row`` (a file created exclusively); False: taken."""
+        try:
+            claim = os.open(f"{self.path}.rows-{row}", os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            os.close(claim)
+        except OSError:
+            return False
+        return True
+
     def remove(self) -> None:
-        """Remove the file (the maps stay valid until their arrays are let go)."""
-        Path(self.path).unlink(missing_ok=True)
+        """Remove the file and its claims (the maps stay valid until their arrays are let go)."""
+        path = Path(self.path)
+        for claim in path.parent.glob(f"{path.name}.rows-*"):
+            claim.unlink(missing_ok=True)
+        path.unlink(missing_ok=True)
