@@ -9,19 +9,30 @@ measurement noise 0.02), ``--samples`` samples (default 1e7) written block by bl
 Runs, all in one invocation:
 
 * ``single``: ``CLPC().run(u, y)`` in a fresh subprocess (the record loaded into memory first,
-  not timed; the trace kept), best of ``--repeat``;
+  not timed; the trace kept);
 * ``run_long N``: :func:`clpc.distributed.run_long` on a ``LocalCluster`` of ``N`` worker
   processes (one thread each): the workers read their memory-mapped slices of the ``.npy``
   file; the trace's rows come back to this process (as ``run`` returns them);
 * ``track_long N``: :func:`clpc.distributed.track_long`: the workers write the trace as a
   partitioned Parquet dataset; only the arrays of the summary, the updates of the report's
-  figures and the last updates come back (Dask's size estimates of the results).
+  figures and the last updates come back (Dask's size estimates of the results);
+* like with like for ``track_long``, whose work includes writing the trace and the summary
+  that ``CLPC.run`` does not: ``clpc track FILE -u 0 -y 1 --format parquet --out OUT`` in
+  one fresh process (:func:`clpc.workflows.track_file`: the Parquet trace file, the summary,
+  the figures and ``report.html``; warmed up on a short record first, so the plotting
+  imports are not timed), against ``clpc track ... --workers N`` on the same cluster
+  (``clpc_track N``: :func:`clpc.distributed.long_track.track_settings`, i.e.
+  ``track_long`` then the same report, warmed up the same way).
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
-kernel is loaded in each worker), then timed. The ``run_long`` trace is compared with the
-single-process trace array by array (SHA-256 of every array: bit for bit).
+kernel is loaded in each worker, the report's imports in this process), then timed. The
+``run_long`` trace is compared with the single-process trace array by array (SHA-256 of
+every array: bit for bit).
 
-Each distributed run is repeated ``--repeat`` times and the fastest kept (as ``single``).
+Each distributed run is repeated ``--repeat`` times and the fastest kept; before each round
+of the distributed runs the two references run once each (in fresh processes), so that on
+a shared machine both sides meet the same load, and the fastest of all their runs is the
+reference.
 Reported: wall time, samples/s, speed-up over ``single``; pieces; the time the workers spent
 computing (summed over the task stream, by task: solve, piece info, finish); the CPU time
 of each worker process and of this process (the client and the local cluster's scheduler:
@@ -30,7 +41,8 @@ the wall time; the scheduler overhead per piece = (N x wall - computing) / piece
 worker was not computing: scheduling, transfers, waiting for a core or for the client);
 bytes per piece sent between
 workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
-(the pickled size of every result); peak RSS of each worker and of this process (added by
+(Dask's sizes of the finishes' results: with ``run_long`` on one machine only the windows'
+levels, the rows being in the shared trace); peak RSS of each worker and of this process (added by
 the run). The load average is printed before and after: the machine may be shared.
 
 Usage::
@@ -45,7 +57,6 @@ import argparse
 import hashlib
 import json
 import os
-import pickle
 import resource
 import subprocess
 import sys
@@ -61,6 +72,9 @@ DEN = np.array([1.0, -1.5, 0.7])
 NUM = np.array([0.5, 0.3, 0.1])
 EQ_NOISE, MEAS_NOISE = 0.1, 0.02
 SEED = 20240607
+#: the distributed runs: run_long and track_long (against CLPC.run), and clpc track
+#: --workers (track_long and the report; against clpc track in one process)
+MODES = ("run_long", "track_long", "clpc_track")
 
 
 def generate_npy(path: Path, n: int, block: int = 1_000_000) -> None:
@@ -90,6 +104,31 @@ def digests(trace: Any) -> dict[str, str]:
 
 def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def track_settings_of(path: str, out: Path) -> Any:
+    """``clpc track PATH -u 0 -y 1 --format parquet --out OUT`` (default appraiser settings)."""
+    import clpc.workflows as wf
+
+    record = wf.RecordSpec(path, ("0",), ("1",))
+    return wf.TrackSettings(record, str(out), wf.AppraiserSettings(), fmt="parquet")
+
+
+def single_track(path: str, repeat: int) -> dict[str, Any]:
+    """``clpc track`` in this process (call it in a fresh one): trace file, summary, report."""
+    import clpc.workflows as wf
+
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = Path(tmpdir)
+        warm = tmp / "warm.npy"
+        np.save(warm, np.load(path, mmap_mode="r")[:50_000])
+        wf.track_file(track_settings_of(str(warm), tmp / "warm"))  # imports, compiled kernel
+        best = (np.inf, np.inf)
+        for i in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            result = wf.track_file(track_settings_of(path, tmp / f"out{i}"))
+            best = min(best, (time.perf_counter() - t0, time.process_time() - c0))
+    return {"wall": best[0], "cpu": best[1], "updates": result.summary["updates"]}
 
 
 def single(path: str, repeat: int) -> dict[str, Any]:
@@ -135,13 +174,18 @@ def _incoming_bytes(client: Any) -> int:
 
 
 def distributed_runs(
-    path: str, n_workers: int, reference: dict[str, Any], tmp: Path, repeat: int = 1
+    path: str, n_workers: int, tmp: Path, repeat: int = 1, between: Any = None
 ) -> list[dict[str, Any]]:
-    """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes."""
+    """``run_long`` and ``track_long`` on a local cluster of ``n_workers`` processes.
+
+    ``between()``, if given, is called before each round of the modes (the references run
+    there, in turn with the distributed runs, so that both meet the same load).
+    """
     import distributed
 
     from clpc import CLPC
     from clpc.distributed import dask_client, run_long, track_long
+    from clpc.distributed.long_track import track_settings
     from clpc.distributed.sources import NpySource
 
     source = NpySource(path, (0,), (1,))
@@ -151,7 +195,11 @@ def distributed_runs(
     with dask_client(workers=n_workers) as client:
         for _ in range(2):  # every worker loads the kernel
             run_long(CLPC(), NpySource(str(warm), (0,), (1,)), client=client, piece_samples=10_000)
-        for mode in [m for m in ("run_long", "track_long") for _ in range(repeat)]:
+        # the report's imports in this process, as the single clpc track's warm-up does
+        track_settings(track_settings_of(str(warm), tmp / "warm"), client=client)
+        for mode in [m for _ in range(repeat) for m in MODES]:
+            if mode == MODES[0] and between is not None:
+                between()
             base = _incoming_bytes(client)
             rss0 = _peak_rss_mb()
             cpu0 = client.run(time.process_time)
@@ -161,27 +209,35 @@ def distributed_runs(
                     trace = run_long(CLPC(), source, client=client)
                     wall = time.perf_counter() - t0
                     updates = len(trace)
-                else:
+                elif mode == "track_long":
                     result = track_long(CLPC(), source, tmp / f"out{n_workers}", client=client)
                     wall = time.perf_counter() - t0
                     updates = result.summary["updates"]
                     result.close()
+                else:  # clpc track --workers N: track_long, then the report
+                    done, _ = track_settings(
+                        track_settings_of(path, tmp / f"cli{n_workers}"), client=client
+                    )
+                    wall = time.perf_counter() - t0
+                    updates = done.summary["updates"]
                 client_cpu = time.process_time() - c0
             cpu1 = client.run(time.process_time)
             worker_cpu = [cpu1[w] - cpu0[w] for w in cpu1 if w in cpu0]
-            equal, to_client = None, None
+            equal = None
             if mode == "run_long":  # checked after the timing
-                equal = digests(trace) == reference["digests"]
-                # what came back: the trace rows (pickled sizes of the arrays)
-                to_client = sum(len(pickle.dumps(a, protocol=5)) for a in trace.arrays.values())
+                equal = digests(trace)  # compared with the single process's in main
                 del trace
             seconds = _task_seconds(ts.data)
             pieces = sum(1 for t in ts.data if str(t["key"]).startswith("solve_piece"))
             computing = sum(seconds.values())
-            if to_client is None:  # summary, figures, last rows: Dask's sizes of the results
-                to_client = sum(
-                    t["nbytes"] for t in ts.data if str(t["key"]).startswith("write_piece")
-                )
+            # what the finishes sent back: Dask's sizes of the results (run_long: the rows,
+            # or only the levels when the workers wrote the rows into the shared trace;
+            # track_long: summary arrays, figures' and last rows)
+            to_client = sum(
+                t.get("nbytes", 0)
+                for t in ts.data
+                if str(t["key"]).startswith(("finish_piece", "write_piece"))
+            )
             worker_rss = client.run(
                 lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
             )
@@ -208,11 +264,14 @@ def distributed_runs(
 
 def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     secs, wall = row["seconds"], row["wall"]
+    if row["mode"] == "clpc_track":  # like with like: against clpc track in one process
+        ref = ref["track"]
     info = secs.get("piece_info", 0.0)
     finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
     print(
         f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
-        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x  "
+        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x "
+        f"(vs {'clpc track' if row['mode'] == 'clpc_track' else 'CLPC.run'})  "
         f"equal to single: {row['equal']}"
     )
     print(
@@ -236,9 +295,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeat", type=int, default=1, help="repetitions of each run (best kept)")
     parser.add_argument("--single-worker", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--single-track", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.single_worker:
         print(json.dumps(single(args.single_worker[0], int(args.single_worker[1]))))
+        return
+    if args.single_track:
+        print(json.dumps(single_track(args.single_track[0], int(args.single_track[1]))))
         return
     n = int(1e6 if args.quick else args.samples)
     print(f"load average before: {os.getloadavg()}; cores: {os.cpu_count()}")
@@ -250,19 +313,36 @@ def main() -> None:
         took = time.perf_counter() - t0
         print(f"record: {n:.3g} samples, {path.stat().st_size / 1e6:.0f} MB ({took:.1f} s)")
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-        cmd = [sys.executable, __file__, "--single-worker", str(path), str(args.repeat)]
-        ref = json.loads(
-            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
-        )
+        singles: list[dict[str, Any]] = []
+        tracks: list[dict[str, Any]] = []
+
+        def references() -> None:  # one run of each, each in a fresh process
+            for flag, out in (("--single-worker", singles), ("--single-track", tracks)):
+                cmd = [sys.executable, __file__, flag, str(path), "1"]
+                done = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+                out.append(json.loads(done.stdout))
+
+        rows = {
+            w: distributed_runs(str(path), w, tmp, args.repeat, references) for w in args.workers
+        }
+        ref = min(singles, key=lambda r: r["wall"])
+        ref["track"] = track = min(tracks, key=lambda r: r["wall"])
         print(
             f"\nsingle      wall {ref['wall']:7.2f} s  cpu {ref['cpu']:7.2f} s  "
             f"{n / ref['wall']:10.3g} samples/s  {ref['updates']} updates  "
-            f"peak RSS added {ref['rss_added_mb']:.0f} MB"
+            f"peak RSS added {ref['rss_added_mb']:.0f} MB  (best of {len(singles)})"
         )
-        for w in args.workers:
-            rows = distributed_runs(str(path), w, ref, tmp, args.repeat)
-            for mode in ("run_long", "track_long"):
-                _show(min((r for r in rows if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
+        print(
+            f"clpc track  wall {track['wall']:7.2f} s  cpu {track['cpu']:7.2f} s  "
+            f"{n / track['wall']:10.3g} samples/s  {track['updates']} updates "
+            f"(one process: Parquet trace file, summary, figures, report; best of {len(tracks)})"
+        )
+        for runs in rows.values():
+            for row in runs:
+                if row["mode"] == "run_long":
+                    row["equal"] = row["equal"] == ref["digests"]
+            for mode in MODES:
+                _show(min((r for r in runs if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
     print(f"\nload average after: {os.getloadavg()}")
 
 

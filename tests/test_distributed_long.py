@@ -82,6 +82,9 @@ def test_pieces_cover_every_update_once_with_the_rows_their_windows_need():
         (20_011, {}, 1_000),  # the paper's W = 201, C = 12; pieces start mid-cluster
         (12_347, {"window_size": 50, "cluster_size": 7, "order": 3}, 333),
         (10_003, {"window_size": 64, "cluster_size": 16, "guard": False}, 4_099),
+        # pieces of several kernel batches (> 2048 updates) and blocks of 8 rows (C = 2):
+        # pieces start at multiples of C, not of the block
+        (30_011, {"window_size": 50, "cluster_size": 2}, 9_002),
     ],
 )
 def test_a_dask_record_gives_the_single_process_trace_bit_for_bit(client, n, settings, piece):

@@ -7,6 +7,7 @@ the traces of one record are made (:class:`~clpc.appraiser.trace_labels.TraceLab
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
@@ -146,7 +147,7 @@ class Trace:
         return replace(first, **kw, arrays=arrays)
 
     @classmethod
-    def allocate(cls, like: Trace, n: int) -> Trace:
+    def allocate(cls, like: Trace, n: int, empty: Callable[..., np.ndarray] = np.empty) -> Trace:
         """An uninitialised trace of ``n`` rows shaped like ``like`` (fill it with :meth:`put`).
 
         Lets a long run write its parts into the final arrays instead of concatenating them
@@ -158,12 +159,14 @@ class Trace:
             A trace of the same appraiser (its settings, names and array shapes per row).
         n : int
             Rows to allocate.
+        empty : callable
+            ``empty(shape, dtype)`` makes each array, always in the same order (default
+            :func:`numpy.empty`; e.g. views of a memory map).
         """
         kw: dict[str, Any] = {
-            f: np.empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype)
-            for f in _ROW_FIELDS
+            f: empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in _ROW_FIELDS
         }
-        arrays = {k: np.empty((n, *v.shape[1:]), v.dtype) for k, v in like.arrays.items()}
+        arrays = {k: empty((n, *v.shape[1:]), v.dtype) for k, v in like.arrays.items()}
         return replace(like, **kw, arrays=arrays, meta=dict(like.meta))
 
     def view(self, start: int, stop: int) -> Trace:

@@ -3,12 +3,15 @@
 The record is cut into pieces of consecutive updates (:mod:`clpc.distributed.pieces`). Per
 piece, a worker reads its samples (a memory-mapped ``.npy`` slice, Parquet row groups, or
 a slice of a ``dask.array`` computed on the workers: no sample passes through the client),
-solves its windows and runs the finite-state machine over them from "no model yet"; the
-client carries the FSM state from piece to piece (a few numbers each), and the worker
-redoes the piece's first updates, up to each equation's first accepted one, from that
-state (:mod:`.piece_tasks`); last, each piece's trace rows are built (returned, or written
-by the worker as one file of a Parquet dataset).
-Pieces in flight are bounded (:mod:`.schedule`), so memory stays O(piece).
+solves its windows and runs the finite-state machine over them from "no model yet",
+straight into the piece's trace rows; the client carries the FSM state from piece to piece
+(a few numbers each), and the piece's first updates, up to each equation's first accepted
+one, are run again from that state (:mod:`.piece_tasks`). On the client's machine the rows
+lie in the record's trace in shared memory (:mod:`.shared_rows`): the workers write them
+there and the client settles them in its map, so no rows are sent; a worker of another
+machine settles its piece and returns the rows (or, in :mod:`.long_track`, writes them as
+one file of a Parquet dataset). Pieces in flight are bounded (:mod:`.schedule`), so
+memory stays O(piece).
 
 The trace equals ``CLPC(...).run(u, y)`` bit for bit without decimation; with decimation
 each piece starts its anti-alias filter a warm-up earlier (:func:`.pieces.warmup`) and the
@@ -17,7 +20,7 @@ numbers agree to rounding (``docs/distributed-long.md``).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -27,11 +30,10 @@ from clpc.appraiser.trace import Trace
 from clpc.data import DataError
 from clpc.data.samples import check_ranges
 from clpc.distributed.cluster import dask_client
-from clpc.distributed.piece_tasks import (
-    RecordPlan,
-)
-from clpc.distributed.pieces import Layout
+from clpc.distributed.piece_tasks import FsmTuple, PieceInfo, RecordPlan, SolvedPiece, settle
+from clpc.distributed.pieces import Layout, Piece
 from clpc.distributed.schedule import run_pieces
+from clpc.distributed.shared_rows import Mapped, SharedRows
 from clpc.distributed.sources import NpySource, ParquetSource
 
 __all__ = [
@@ -103,24 +105,65 @@ def gather(parts: list[Trace]) -> Trace:
     return trace
 
 
-class _Joined:
-    """A record's trace filled piece by piece as the pieces arrive (one copy in memory)."""
+class _InPlace(NamedTuple):
+    """A piece settled by the client in the shared trace."""
 
-    def __init__(self, total: int) -> None:
-        self.total = total
+    start: int  #: its first row
+    n_rows: int  #: its rows
+
+
+class _Joined:
+    """A record's trace filled piece by piece as the pieces arrive (one copy in memory).
+
+    ``shared``: the record's trace in shared memory, which the workers of this machine
+    write themselves, with each window's own ``c`` and level as extra arrays
+    (:class:`.shared_rows.SharedRows` and the client's map of it); else the trace is made
+    from the first piece sent.
+    """
+
+    def __init__(self, plan: RecordPlan, shared: tuple[SharedRows, Mapped] | None) -> None:
+        self.plan = plan
+        self.total = plan.layout.updates(plan.n_raw)
+        self.shared: SharedRows | None = None
+        self.mapped: Mapped | None = None
         self.trace: Trace | None = None
+        if shared is not None:
+            self.shared, self.mapped = shared
+            self.trace = self.mapped.trace
         self.done = 0
         self.levels: list[np.ndarray] = []
 
-    def add(self, part: Trace) -> None:
+    def settle(self, piece: Piece, info: PieceInfo, state: FsmTuple) -> _InPlace:
+        """Finish a piece the workers wrote into the shared trace (in this process's map)."""
+        assert self.mapped is not None
+        lo, hi = piece.j_lo - 1, piece.j_hi
+        c = self.mapped.extra[0][lo:hi]
+        here = SolvedPiece(piece, self.mapped.trace.view(lo, hi), c, info.first, info.peaks, True)
+        settle(here, self.plan, state)
+        return _InPlace(lo, hi - lo)
+
+    def add(self, part: Trace | _InPlace) -> None:
+        if isinstance(part, _InPlace):
+            assert part.start == self.done, (part.start, self.done)
+            self.done += part.n_rows
+            return
+        start, stop = self.done, self.done + len(part)
         if self.trace is None:
             self.trace = Trace.allocate(part, self.total)
-        self.done = self.trace.put(self.done, part)
-        self.levels.append(part.meta["window_level"])
+        elif self.shared is not None:  # sent by a worker that does not see the file
+            self.shared.reserve((start, stop))
+        self.done = self.trace.put(start, part)
+        if self.mapped is not None:
+            self.mapped.extra[1][start:stop] = part.meta["window_level"]
+        else:
+            self.levels.append(part.meta["window_level"])
 
     def result(self) -> Trace:
         assert self.trace is not None and self.done == self.total, (self.done, self.total)
-        self.trace.meta["window_level"] = np.concatenate(self.levels)
+        if self.mapped is not None:
+            self.trace.meta["window_level"] = self.mapped.extra[1]
+        else:
+            self.trace.meta["window_level"] = np.concatenate(self.levels)
         return self.trace
 
 
@@ -204,8 +247,19 @@ def run_long(
             config = appraiser.config()
             short = dask.submit(_short_record, config, raw, channels[0], dt, pure=False)
             return short.result()
-        joined = _Joined(plan.layout.updates(n_raw))
-        _, peaks = run_pieces(dask, plan, record, piece_samples, sink=joined.add)
+        # the extra arrays: each window's own c and level, per output
+        extra = ((channels[1],), (channels[1],))
+        made = SharedRows.create(plan.state().empty_trace(), plan.layout.updates(n_raw), extra)
+        shared = made[0] if made is not None else None
+        joined = _Joined(plan, made)
+        try:
+            _, peaks = run_pieces(
+                dask, plan, record, piece_samples, sink=joined.add, shared=shared,
+                local=joined.settle,
+            )  # fmt: skip
+        finally:
+            if shared is not None:
+                shared.remove()
     check_peaks(appraiser, peaks, channels[0])
     return joined.result()
 

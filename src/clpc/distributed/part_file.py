@@ -18,7 +18,7 @@ import numpy as np
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.tracefile import trace_column_list
 from clpc.core.atomic import atomic_path
-from clpc.distributed.piece_tasks import FsmTuple, RecordPlan, SolvedPiece, finish_piece
+from clpc.distributed.piece_tasks import FsmTuple, RecordPlan, SolvedPiece, settle
 
 __all__ = ["WrittenPiece", "write_part", "write_piece"]
 
@@ -80,7 +80,8 @@ def write_piece(
         0`` (as :class:`clpc.appraiser.thinned.ThinnedTrace` keeps them); ``last`` updates
         are returned from the piece's end.
     """
-    trace = finish_piece(solved, plan, state)
+    settle(solved, plan, state)
+    trace = solved.trace
     write_part(trace, Path(folder) / f"part-{solved.piece.number:06d}.parquet")
     stride, last = thin
     numbers = np.arange(solved.piece.j_lo - 1, solved.piece.j_hi)

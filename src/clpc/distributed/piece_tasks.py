@@ -1,30 +1,32 @@
 """What a worker does with one piece of a long record (see :mod:`clpc.distributed.pieces`).
 
-Two tasks per piece, functions of picklable arguments, both run in parallel:
+Two steps per piece, functions of picklable arguments:
 
 1. :func:`solve_piece`: read the piece's raw samples (from the file, or the slice of a
    ``dask.array`` computed on a worker), check them as :meth:`clpc.CLPC.push` does,
-   decimate, solve every window with the kernel's stateless solve
-   (:func:`clpc.appraiser.kernel.solve`), and run the finite-state machine's output
-   (:func:`clpc.appraiser.kernel.output`) over them from "no model yet". That output is
-   already the record's from each equation's first accepted update of the piece on: an
+   decimate, and solve every window and run the finite-state machine's output over them
+   from "no model yet", in one pass of the kernel (:func:`clpc.appraiser.kernel.solve_updates`,
+   as :meth:`clpc.CLPC.run` runs it) straight into the piece's trace rows (its own arrays,
+   or the rows of the record's trace in shared memory, :mod:`.shared_rows`). That output
+   is already the record's from each equation's first accepted update of the piece on: an
    accepted update replaces the whole carried state (the held theta, c and the has-a-model
    flag), so nothing before it is seen after it. :func:`piece_info` is the few numbers the
-   client needs (:class:`PieceInfo`): the channels' extremes, the state the piece ends in
-   and which equations accepted an update in it;
-2. :func:`finish_piece` / :func:`write_piece`: given the state the record's FSM is in when
-   the piece starts (:func:`next_state` of the pieces before, computed on the client),
-   :func:`settle` runs the FSM again over the piece's first updates, up to each equation's
-   first accepted one (usually a handful), from that state; then the piece's trace rows are
-   returned, or written by the worker to one file of a Parquet dataset with only what a
-   summary and a report need returned.
+   client needs (:class:`PieceInfo`): the channels' extremes, the state the piece ends in,
+   which equations accepted an update in it and where first;
+2. :func:`settle`, given the state the record's FSM is in when the piece starts
+   (:func:`next_state` of the pieces before, computed on the client), runs the FSM again
+   over the piece's first updates, up to each equation's first accepted one (usually a
+   handful), from that state, in place: on the worker that holds the piece
+   (:func:`finish_piece`, the rows then returned, or :func:`.part_file.write_piece`), or on
+   the client in its map of the shared trace.
 
-No task waits for another piece's task, and only the FSM state (a few numbers per output)
-goes from the client to a worker.
+No step waits for another piece's, and only the FSM state (a few numbers per output) goes
+from the client to a worker.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -37,6 +39,7 @@ from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
 from clpc.distributed.pieces import Layout, Piece
+from clpc.distributed.shared_rows import SharedRows
 
 __all__ = [
     "PieceInfo",
@@ -107,19 +110,18 @@ def trace_nbytes(trace: Trace) -> int:
 
 
 class SolvedPiece(NamedTuple):
-    """The solved windows of a piece, batch by batch (:func:`clpc.appraiser.kernel.batches`).
+    """A solved piece: its trace rows, written by the kernel as :meth:`clpc.CLPC.run` writes.
 
-    ``outputs`` is the FSM output from "no model yet" until :func:`settle` makes the first
+    ``trace`` holds the FSM output from "no model yet" until :func:`settle` makes the first
     updates the record's (in place; settling again gives the same).
     """
 
     piece: Piece
-    batches: list[tuple[int, int]]
-    solved: list[kernel.Solved]
-    outputs: list[kernel.FsmOutput]
+    trace: Trace  #: the piece's rows (``index``, ``time``, every array; levels in ``meta``)
+    solved_c: np.ndarray  #: (count, E): each window's own ``c`` (not a trace column)
     first_accepted: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
-    levels: np.ndarray | None  #: (count, n_out): each window's mean output (record samples)
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum in the piece
+    shared: bool  #: ``trace`` and ``solved_c`` are views of the record's shared trace
 
 
 try:  # Dask's memory accounting sizes a returned trace or solved piece by its arrays
@@ -131,8 +133,7 @@ else:
 
     @sizeof.register(SolvedPiece)
     def _solved_nbytes(solved: SolvedPiece) -> int:
-        parts = [*solved.solved, *solved.outputs]
-        return sum(a.nbytes for part in parts for a in part)
+        return trace_nbytes(solved.trace) + solved.solved_c.nbytes
 
 
 class PieceInfo(NamedTuple):
@@ -141,6 +142,8 @@ class PieceInfo(NamedTuple):
     peaks: np.ndarray  #: (2, channels): each raw channel's maximum and minimum
     end: FsmTuple  #: the FSM state after the piece, for the equations that accepted in it
     accepted: np.ndarray  #: (E,) bool: the equation accepted an update in the piece
+    first: np.ndarray  #: (E,) int64: each equation's first accepted update (-1: none)
+    shared: bool  #: the rows are in the record's shared trace (SolvedPiece.shared)
 
 
 def _kept(raw: np.ndarray, layout: Layout, piece: Piece) -> np.ndarray:
@@ -175,8 +178,14 @@ def _peaks(columns: list[np.ndarray]) -> np.ndarray:
     return np.array([[c.max() for c in columns], [c.min() for c in columns]])
 
 
-def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
+def solve_piece(
+    raw: Any, plan: RecordPlan, piece: Piece, shared: SharedRows | None = None
+) -> SolvedPiece:
     """Read (or take), check and decimate a piece's samples; solve its windows; run the FSM.
+
+    The kernel writes straight into the piece's trace arrays, batch by batch with its block
+    cache, as :meth:`clpc.CLPC.run` does (:func:`clpc.appraiser.kernel.solve_updates`): the
+    same operations, so the same numbers bit for bit, and no copy of the rows.
 
     Parameters
     ----------
@@ -185,6 +194,10 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
         source with a ``read(lo, hi)`` method (:mod:`clpc.distributed.sources`), read here.
     plan : RecordPlan
     piece : Piece
+    shared : SharedRows, optional
+        The record's trace in shared memory (with two extra arrays: each window's own
+        ``c`` and level): when this process sees it, the kernel writes the piece's rows
+        there (else into the piece's own arrays), and the client settles them itself.
 
     Raises
     ------
@@ -199,25 +212,41 @@ def solve_piece(raw: Any, plan: RecordPlan, piece: Piece) -> SolvedPiece:
         n_in = plan.channels[0]
         u, y = as_chunk(both[:, :n_in], both[:, n_in:], piece.raw[0])
     samples = _kept(both, plan.layout, piece)
-    setup = plan.state().kernel_setup()
+    st = plan.state()
+    setup = st.kernel_setup()
+    lo, hi = piece.j_lo - 1, piece.j_hi
+    mapped = shared.open(st.empty_trace(), (lo, hi)) if shared is not None else None
+    if mapped is None:
+        trace = Trace.allocate(st.empty_trace(), piece.updates)
+        dest = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+    else:  # rows of the shared trace; the windows' own c in its first extra array
+        view = mapped.trace.view(lo, hi)
+        trace = dataclasses.replace(view, meta=dict(view.meta))
+        windows, out = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+        dest = (tuple(kernel.Solved(*windows)._replace(c=mapped.extra[0][lo:hi])), out)
+    cache = kernel.new_cache(setup.plan.chan.shape, kernel.cache_blocks(setup.plan))
     first_row = piece.kept[0] - plan.layout.max_lag
-    batches = kernel.batches(piece.j_lo, piece.j_hi, 1)
-    solved = [kernel.solve(samples, first_row, b, setup) for b in batches]
-    state = kernel.FsmState(*plan.initial())
-    outputs = [kernel.output(s, setup, state) for s in solved]
-    accepted = np.concatenate([o.accepted for o in outputs])
+    fsm = kernel.FsmState(*plan.initial())
+    kernel.solve_updates(setup, (samples, first_row), (piece.j_lo, piece.j_hi), (fsm, cache), dest)
+    lay = plan.layout
+    trace.index[:] = lay.max_lag + lay.cluster * np.arange(piece.j_lo, piece.j_hi + 1) - 1
+    trace.time[:] = trace.index * trace.sample_time
+    accepted = trace.arrays["accepted"]
     first = np.where(accepted.any(axis=0), accepted.argmax(axis=0), -1)
-    rows = np.concatenate([s.n_rows for s in solved])
-    levels = _levels(y, plan, piece, rows) if plan.levels else None
+    if plan.levels:
+        trace.meta["window_level"] = _levels(y, plan, piece, trace.rows)
+        if mapped is not None:  # the second extra array
+            mapped.extra[1][lo:hi] = trace.meta["window_level"]
     peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
-    return SolvedPiece(piece, batches, solved, outputs, first, levels, peaks)
+    return SolvedPiece(piece, trace, kernel.Solved(*dest[0]).c, first, peaks, mapped is not None)
 
 
 def piece_info(solved: SolvedPiece) -> PieceInfo:
     """The extremes and the end state of a solved piece (see :func:`next_state`)."""
-    last = solved.outputs[-1]
-    end = (last.theta[-1].copy(), last.c[-1].copy(), last.has_model[-1].copy())
-    return PieceInfo(solved.peaks, end, solved.first_accepted >= 0)
+    arrays = solved.trace.arrays
+    end = (arrays["theta"][-1].copy(), arrays["c"][-1].copy(), arrays["has_model"][-1].copy())
+    first = solved.first_accepted
+    return PieceInfo(solved.peaks, end, first >= 0, first.copy(), solved.shared)
 
 
 def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
@@ -231,53 +260,28 @@ def next_state(state: FsmTuple, info: PieceInfo) -> FsmTuple:
     return theta, np.where(ok, info.end[1], state[1]), np.where(ok, info.end[2], state[2])
 
 
-def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> list[kernel.FsmOutput]:
-    """The piece's FSM output as the record's, given the state the record is in before it.
+def settle(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> int:
+    """Make the piece's FSM output the record's, given the state the record is in before it.
 
     Runs the FSM from ``state`` over the updates before (and at) the last of the
     equations' first accepted updates (every update when an equation accepted none); the
-    later updates' outputs do not depend on ``state``. Updates ``solved.outputs`` in place.
+    later updates' outputs do not depend on ``state``. Writes into ``solved.trace`` (in
+    place) and returns the number of rows it wrote (the piece's first ones).
     """
+    trace = solved.trace
     ends = np.where(solved.first_accepted >= 0, solved.first_accepted, solved.piece.updates - 1)
     todo = int(ends.max()) + 1
     setup = plan.state().kernel_setup()
     carried = kernel.FsmState(*(np.array(a, copy=True) for a in state))
-    done = 0
-    for sol, out in zip(solved.solved, solved.outputs, strict=True):
-        n = min(out.theta.shape[0], todo - done)
-        if n <= 0:
-            break
-        head = kernel.Solved(*(a[:n] for a in sol))
-        again = kernel.output(head, setup, carried)
-        for have, want in zip(out, again, strict=True):
-            have[:n] = want
-        done += n
-    return solved.outputs
-
-
-def _arrays(sol: kernel.Solved, fsm: kernel.FsmOutput) -> dict[str, np.ndarray]:
-    """A trace part's per-update arrays: the FSM's output and the windows' own solution."""
-    arrays: dict[str, np.ndarray] = dict(fsm._asdict())
-    for key, value in sol._asdict().items():
-        if key not in ("theta", "c"):
-            arrays[key] = value
-    arrays["theta_estimate"] = sol.theta
-    return arrays
-
-
-def _trace(solved: SolvedPiece, outputs: list[kernel.FsmOutput], plan: RecordPlan) -> Trace:
-    """The trace rows of a piece (``meta["window_level"]``: its windows' levels, if any)."""
-    labels = plan.state().trace_labels()
-    lay = plan.layout
-    parts = []
-    for (j0, count), sol, out in zip(solved.batches, solved.solved, outputs, strict=True):
-        arrays = _arrays(sol, out)
-        index = lay.max_lag + lay.cluster * np.arange(j0, j0 + count) - 1
-        parts.append(labels.trace(index, arrays.pop("n_rows"), arrays))
-    trace = parts[0] if len(parts) == 1 else Trace.concat(parts)
-    if solved.levels is not None:
-        trace.meta["window_level"] = solved.levels
-    return trace
+    windows, out = kernel.trace_outputs(trace.arrays, trace.rows, trace.not_enough_data)
+    head = kernel.Solved(*windows)._replace(c=solved.solved_c)
+    kernel.fsm_output(
+        kernel.Solved(*(a[:todo] for a in head)),
+        setup.fsm,
+        carried,
+        kernel.FsmOutput(*(a[:todo] for a in out)),
+    )
+    return todo
 
 
 def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trace:
@@ -285,4 +289,5 @@ def finish_piece(solved: SolvedPiece, plan: RecordPlan, state: FsmTuple) -> Trac
 
     ``state``: the record's FSM state before the piece (:func:`next_state`).
     """
-    return _trace(solved, settle(solved, plan, state), plan)
+    settle(solved, plan, state)
+    return solved.trace
