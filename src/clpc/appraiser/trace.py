@@ -1,8 +1,7 @@
 """The output of the appraiser: one row per cluster update, plus the convergence verdict.
 
-The keys of its arrays and its table layout are in :mod:`clpc.appraiser.trace_table`; how
-the traces of one record are made (:class:`~clpc.appraiser.trace_labels.TraceLabels`) in
-:mod:`clpc.appraiser.trace_labels`.
+Array keys and table layout: :mod:`clpc.appraiser.trace_table`; how the traces of one record
+are made: :class:`~clpc.appraiser.trace_labels.TraceLabels`.
 """
 
 from __future__ import annotations
@@ -160,8 +159,7 @@ class Trace:
         n : int
             Rows to allocate.
         empty : callable
-            ``empty(shape, dtype)`` makes each array, always in the same order (default
-            :func:`numpy.empty`; e.g. views of a memory map).
+            ``empty(shape, dtype)`` makes each array, in a fixed order (e.g. views of a map).
         """
         kw: dict[str, Any] = {
             f: empty((n, *getattr(like, f).shape[1:]), getattr(like, f).dtype) for f in _ROW_FIELDS
