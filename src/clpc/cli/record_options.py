@@ -78,17 +78,24 @@ def time_base_options() -> Decorator:
     )
 
 
+def time_column_option(help_text: str) -> Decorator:
+    """``--time COL`` (into ``time_col``): the column of sample times.
+
+    Parameters
+    ----------
+    help_text : str
+        What the command does with the column (streams and files differ).
+    """
+    return click.option("--time", "time_col", metavar="COL", default=None, help=help_text)
+
+
 def stream_sampling_options() -> Decorator:
     """``--dt``, ``--time COL`` (into ``time_col``), ``--time-unit``, ``--time-rtol``."""
     return combine(
         dt_option(),
-        click.option(
-            "--time",
-            "time_col",
-            metavar="COL",
-            default=None,
-            help="Column of sample times; dt is the mean of its first steps; a gap is "
-            "reported and the grid re-anchored, a stamp off the grid is a malformed line.",
+        time_column_option(
+            "Column of sample times; dt is the mean of its first steps; a gap is reported and "
+            "the grid re-anchored, a stamp off the grid is a malformed line."
         ),
         time_base_options(),
     )
@@ -102,13 +109,9 @@ def sampling_options() -> Decorator:
     """
     return combine(
         dt_option(),
-        click.option(
-            "--time",
-            "time_col",
-            metavar="COL",
-            default=None,
-            help="Column of sample times; dt is its mean step (steps within --time-rtol; a "
-            "gap of whole sample times is reported and the grid re-anchored).",
+        time_column_option(
+            "Column of sample times; dt is its mean step (steps within --time-rtol; a gap of "
+            "whole sample times is reported and the grid re-anchored)."
         ),
         time_base_options(),
         click.option(

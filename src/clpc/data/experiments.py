@@ -15,7 +15,7 @@ import numpy as np
 
 from clpc.data.validation import DataError
 
-__all__ = ["Experiments", "check_experiments", "slice_experiments"]
+__all__ = ["Experiments", "RecordLike", "RecordT", "check_experiments", "slice_experiments"]
 
 
 def check_experiments(given: Sequence[int] | None, n: int) -> tuple[int, ...]:
@@ -77,39 +77,46 @@ def slice_experiments(experiments: Sequence[int], start: int, stop: int, step: i
     return [int(n) for n in np.clip(ends, start, max(stop, start)) - lo if n > 0]
 
 
-class _Record(Protocol):
-    """What :class:`Experiments` uses of the record it is a base of."""
+class RecordLike(Protocol):
+    """What the record's base classes use of it (:class:`Experiments`, ``Preprocessing``)."""
 
     @property
-    def u(self) -> np.ndarray: ...
+    def u(self) -> np.ndarray:
+        """Inputs, shape (T, n_inputs)."""
 
     @property
-    def y(self) -> np.ndarray: ...
+    def y(self) -> np.ndarray:
+        """Outputs, shape (T, n_outputs)."""
 
     @property
-    def dt(self) -> float: ...
+    def dt(self) -> float:
+        """Sample time [s]."""
 
     @property
-    def input_names(self) -> tuple[str, ...]: ...
+    def input_names(self) -> tuple[str, ...]:
+        """Input channel names."""
 
     @property
-    def output_names(self) -> tuple[str, ...]: ...
+    def output_names(self) -> tuple[str, ...]:
+        """Output channel names."""
 
     @property
-    def experiments(self) -> tuple[int, ...]: ...
+    def experiments(self) -> tuple[int, ...]:
+        """Samples of each experiment, in order."""
 
     def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> Self:
         """A new record with these samples and this record's names."""
 
 
-_R = TypeVar("_R", bound=_Record)
+#: a record of the base classes' methods (``IOData``)
+RecordT = TypeVar("RecordT", bound=RecordLike)
 
 
 class Experiments:
     """``concat`` and ``split`` of a record's experiments; a base class of ``IOData``."""
 
     @classmethod
-    def concat(cls, records: Sequence[_R]) -> _R:
+    def concat(cls, records: Sequence[RecordT]) -> RecordT:
         """Several experiments as one record (their boundaries kept, see :meth:`split`).
 
         Parameters
@@ -149,7 +156,7 @@ class Experiments:
             experiments=[n for r in records for n in r.experiments],
         )
 
-    def split(self: _R) -> list[_R]:
+    def split(self: RecordT) -> list[RecordT]:
         """One record per experiment."""
         ends = np.cumsum(self.experiments)
         return [
@@ -158,6 +165,6 @@ class Experiments:
         ]
 
     @property
-    def n_experiments(self: _Record) -> int:
+    def n_experiments(self: RecordLike) -> int:
         """Number of experiments in the record."""
         return len(self.experiments)

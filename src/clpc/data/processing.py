@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from fractions import Fraction
-from typing import Any, Protocol, Self, TypeVar
 
 import numpy as np
 
+from clpc.data.experiments import RecordT
 from clpc.data.validation import DataError, check_dt
 
 __all__ = [
@@ -161,32 +161,10 @@ def resample_parts(
     return np.concatenate(parts), [p.shape[0] for p in parts]
 
 
-class _Record(Protocol):
-    """What :class:`Preprocessing` uses of the record it is a base of."""
-
-    @property
-    def u(self) -> np.ndarray: ...
-
-    @property
-    def y(self) -> np.ndarray: ...
-
-    @property
-    def dt(self) -> float: ...
-
-    @property
-    def experiments(self) -> tuple[int, ...]: ...
-
-    def _with(self, u: Any, y: Any, dt: float | None = None, experiments: Any = None) -> Self:
-        """A new record with these samples and this record's names."""
-
-
-_R = TypeVar("_R", bound=_Record)
-
-
 class Preprocessing:
     """``detrend``, ``filter`` and ``resample`` of a record; a base class of ``IOData``."""
 
-    def detrend(self: _R, kind: str = "constant") -> _R:
+    def detrend(self: RecordT, kind: str = "constant") -> RecordT:
         """Remove each channel's mean (``"constant"``) or line (``"linear"``) per experiment.
 
         Parameters
@@ -203,12 +181,12 @@ class Preprocessing:
         return self._with(both[:, :n_in], both[:, n_in:])
 
     def filter(
-        self: _R,
+        self: RecordT,
         cutoff: float | Sequence[float],
         btype: str = "lowpass",
         order: int = 4,
         zero_phase: bool = True,
-    ) -> _R:
+    ) -> RecordT:
         """Butterworth-filter every channel (see :func:`filter_parts`).
 
         ``zero_phase=True`` (default) filters forwards and backwards, so the filter adds no
@@ -236,7 +214,7 @@ class Preprocessing:
         n_in = self.u.shape[1]
         return self._with(both[:, :n_in], both[:, n_in:])
 
-    def resample(self: _R, dt: float) -> _R:
+    def resample(self: RecordT, dt: float) -> RecordT:
         """The record at sample time ``dt`` [s] (polyphase, anti-aliased; per experiment).
 
         Parameters
