@@ -43,6 +43,8 @@ from clpc.distributed.part_file import WrittenPiece, write_piece
 from clpc.distributed.piece_tasks import RecordPlan
 from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
+from clpc.distributed.shared_rows import SharedRows
+from clpc.distributed.shared_track import SharedPieces
 from clpc.distributed.sources import NpySource, ParquetSource, open_source
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
@@ -87,6 +89,10 @@ class LongTrack:
         The folder of the trace's Parquet parts.
     parts : int
         Pieces (files of the dataset).
+    in_place : int
+        Of them, the pieces whose rows the workers wrote into the record's trace in shared
+        memory, settled there by the client (:mod:`clpc.distributed.shared_track`); the
+        others' rows were settled by their workers and what the report needs sent back.
     appraised : Appraised
         What a report is made of (:func:`clpc.workflows.track.write_report`).
     """
@@ -96,6 +102,7 @@ class LongTrack:
     model_source: str
     dataset: Path
     parts: int
+    in_place: int
     appraised: Appraised
 
     def close(self) -> None:
@@ -163,12 +170,27 @@ def track_long(
         )
     staging = folder / f".trace-{uuid.uuid4().hex}"
     stride = thinning_stride(total, figure_updates)
-    finish = (write_piece, (str(staging.resolve()), SUMMARY_KEYS, (stride, RECENT)))
+    thinning = (SUMMARY_KEYS, (stride, RECENT))
+    finish = (write_piece, (str(staging.resolve()), *thinning))
     taken = _Taken(ScannedTrace(Path(tempfile.gettempdir())))
+    # the trace in shared memory, each window's own c beside it (None: the rows are sent)
+    made = SharedRows.create(plan.state().empty_trace(), total, ((channels[1],),))
     try:
         with dask_client(client, scheduler, workers) as dask:
-            _, peaks = run_pieces(dask, plan, source, piece_samples, finish, sink=taken.add)
-            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False).result()
+            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False)
+            in_place = None
+            if made is not None:
+                in_place = SharedPieces(dask, plan, made, finish[1][0], thinning, taken.add)
+            _, peaks = run_pieces(
+                dask, plan, source, piece_samples, finish,
+                sink=taken.add if in_place is None else in_place.take,
+                shared=None if made is None else made[0],
+                local=None if in_place is None else in_place.finish,
+            )  # fmt: skip
+            if in_place is not None:
+                in_place.wait()
+                taken.in_place = in_place.pieces
+            tail = tail.result()
         check_peaks(appraiser, peaks, channels[0])
         summary = trace_summary(taken.whole)
         _replace(staging, folder / "trace")
@@ -179,6 +201,8 @@ def track_long(
         raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+        if made is not None:
+            made[0].remove()
     figures = gather(taken.figures)
     figures = dataclasses.replace(
         figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
@@ -187,7 +211,8 @@ def track_long(
     recent = last.take(np.arange(max(len(last) - RECENT, 0), len(last)))
     n_kept = plan.layout.kept(plan.n_raw)
     done = Appraised(appraiser.config(), n_kept, figures, taken.whole, recent, tail)
-    return LongTrack(summary, model, model_source, folder / "trace", taken.parts, done)
+    parts = (taken.parts, taken.in_place)
+    return LongTrack(summary, model, model_source, folder / "trace", *parts, done)
 
 
 class _Taken:
@@ -198,6 +223,7 @@ class _Taken:
         self.figures: list[Trace] = []  # every stride-th update: ~2 figure_updates in all
         self.last: deque[Trace] = deque(maxlen=2)  # the last RECENT updates are in these
         self.parts = 0
+        self.in_place = 0  # of them, pieces settled in the shared trace
 
     def add(self, part: WrittenPiece) -> None:
         self.whole.add(part.summary)
