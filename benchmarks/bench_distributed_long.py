@@ -21,7 +21,7 @@ Runs, all in one invocation:
   one fresh process (:func:`clpc.workflows.track_file`: the Parquet trace file, the summary,
   the figures and ``report.html``; warmed up on a short record first, so the plotting
   imports are not timed), against ``clpc track ... --workers N`` on the same cluster
-  (``clpc_track N``: :func:`clpc.distributed.long_track.track_settings`, i.e.
+  (``clpc_track N``: :func:`clpc.distributed.track_command.track_settings`, i.e.
   ``track_long`` then the same report, warmed up the same way).
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
@@ -185,8 +185,8 @@ def distributed_runs(
 
     from clpc import CLPC
     from clpc.distributed import dask_client, run_long, track_long
-    from clpc.distributed.long_track import track_settings
     from clpc.distributed.sources import NpySource
+    from clpc.distributed.track_command import track_settings
 
     source = NpySource(path, (0,), (1,))
     warm = tmp / "warm.npy"

@@ -45,14 +45,12 @@ from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
 from clpc.distributed.shared_rows import SharedRows
 from clpc.distributed.shared_track import SharedPieces
-from clpc.distributed.sources import NpySource, ParquetSource, open_source
+from clpc.distributed.sources import NpySource, ParquetSource
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
-from clpc.workflows import TrackSettings
-from clpc.workflows.common import SettingsError
-from clpc.workflows.track_report import REPORT_SAMPLES, Appraised, TrackResult, write_report
+from clpc.workflows.track_report import REPORT_SAMPLES, Appraised
 
-__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
+__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long"]
 
 #: the last updates the report's table shows (as ``clpc track``'s)
 RECENT = 20
@@ -256,57 +254,6 @@ def tail_samples(source: NpySource | ParquetSource, plan: RecordPlan, n: int) ->
     raw = source.read(lo, plan.n_raw)
     kept = Decimator(lay.factor)(raw) if lay.factor > 1 else raw
     return np.array(kept[first - lo // lay.factor :], dtype=np.float64)
-
-
-def track_settings(
-    settings: TrackSettings,
-    *,
-    client: Any = None,
-    scheduler: str | None = None,
-    workers: int | None = None,
-) -> tuple[TrackResult, LongTrack]:
-    """``clpc track`` with ``--workers``/``--scheduler``: :func:`track_long`, then the report.
-
-    The record, its columns, ``--dt``, the appraiser's settings and ``--out`` are those of
-    the command; ``OUT`` gets ``trace/`` (the dataset), ``summary.json``, the figures and
-    ``report.html`` of :func:`clpc.workflows.track.write_report`.
-
-    Raises
-    ------
-    SettingsError
-        A time column (give ``--dt``), or a file that is not ``.npy`` or Parquet.
-    """
-    record = settings.record
-    if record.time_col is not None:
-        raise SettingsError(
-            "a record split over workers needs a uniform sample time given with --dt "
-            "(a time column is checked chunk by chunk on one machine: drop --workers/"
-            "--scheduler, or give --dt instead of --time)."
-        )
-    try:
-        keys = record.columns()  # digits as 0-based positions, as clpc track reads them
-        n_in, n_out = len(record.inputs), len(record.outputs)
-        source = open_source(record.file, tuple(keys[:n_in]), tuple(keys[n_in : n_in + n_out]))
-    except DataError as exc:
-        raise SettingsError(str(exc)) from None
-    done = track_long(
-        settings.appraiser.build(record.dt),
-        source,
-        settings.out_dir,
-        dt=record.dt,
-        client=client,
-        scheduler=scheduler,
-        workers=workers,
-        figure_updates=settings.figure_updates,
-    )
-    out = Path(settings.out_dir)
-    try:
-        result = write_report(settings, done.appraised, done.dataset, out)
-    finally:
-        done.close()
-    write_file(out / "summary.json", json.dumps(result.summary, indent=1))
-    files = [*result.files, out / "summary.json"]
-    return dataclasses.replace(result, files=files), done
 
 
 def _replace(new: Path, target: Path) -> None:
