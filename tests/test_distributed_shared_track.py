@@ -169,3 +169,56 @@ def test_a_pieces_rows_are_freed_only_after_the_summary_took_them(tmp_path):
         state = next_state(state, piece_info(solved))
     own = pd.read_parquet(tmp_path / "own")
     assert np.array_equal(mine.to_numpy(dtype=float), own.to_numpy(dtype=float))
+
+
+@needs_shm
+def test_a_worker_killed_while_it_solves_or_writes_leaves_the_dataset_and_summary(tmp_path):
+    """SIGKILL a worker busy with a piece: Dask reruns its tasks; the dataset is equal."""
+    import signal as signals
+    import threading
+    import time
+
+    import distributed
+    import pandas as pd
+
+    from clpc.appraiser.tracefile import trace_columns
+    from clpc.report import trace_summary
+
+    u, y = _record(400_000)
+    np.save(tmp_path / "rec.npy", np.column_stack([u, y]))
+    ref = CLPC().run(u, y)
+    named = dataclasses.replace(ref, input_names=("col0",), output_names=("col1",))
+    killed: dict = {}
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
+        c.wait_for_workers(2)
+        pids = c.run(os.getpid)  # worker address -> its process id
+
+        def kill_a_busy_worker() -> None:
+            deadline = time.monotonic() + 60
+            while not killed and time.monotonic() < deadline:
+                busy = [
+                    (a, k)
+                    for a, keys in c.processing().items()
+                    for k in keys
+                    if a in pids and ("solve" in str(k) or "write_shared" in str(k))
+                ]
+                if busy:
+                    os.kill(pids[busy[0][0]], signals.SIGKILL)
+                    killed.update(pid=pids[busy[0][0]], task=str(busy[0][1]))
+                time.sleep(0.005)
+
+        killer = threading.Thread(target=kill_a_busy_worker)
+        killer.start()
+        source = open_source(tmp_path / "rec.npy", (0,), (1,))
+        done = track_long(CLPC(), source, tmp_path / "out", client=c, piece_samples=20_000)
+        done.close()
+        killer.join()
+    assert killed, "no worker was busy with a piece"
+    table = pd.read_parquet(tmp_path / "out" / "trace").sort_values("index")
+    assert np.array_equal(table.to_numpy(dtype=np.float64), trace_columns(named)[1])
+    assert done.summary == trace_summary(named)
