@@ -176,7 +176,7 @@ def track_long(
     try:
         with dask_client(client, scheduler, workers) as dask:
             tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False)
-            in_place = None
+            in_place, settled = None, 0
             if made is not None:
                 in_place = SharedPieces(dask, plan, made, finish[1][0], thinning, taken.add)
             _, peaks = run_pieces(
@@ -187,7 +187,7 @@ def track_long(
             )  # fmt: skip
             if in_place is not None:
                 in_place.wait()
-                taken.in_place = in_place.pieces
+                settled = in_place.pieces
             tail = tail.result()
         check_peaks(appraiser, peaks, channels[0])
         summary = trace_summary(taken.whole)
@@ -209,7 +209,7 @@ def track_long(
     recent = last.take(np.arange(max(len(last) - RECENT, 0), len(last)))
     n_kept = plan.layout.kept(plan.n_raw)
     done = Appraised(appraiser.config(), n_kept, figures, taken.whole, recent, tail)
-    parts = (taken.parts, taken.in_place)
+    parts = (taken.parts, settled)
     return LongTrack(summary, model, model_source, folder / "trace", *parts, done)
 
 
@@ -221,7 +221,6 @@ class _Taken:
         self.figures: list[Trace] = []  # every stride-th update: ~2 figure_updates in all
         self.last: deque[Trace] = deque(maxlen=2)  # the last RECENT updates are in these
         self.parts = 0
-        self.in_place = 0  # of them, pieces settled in the shared trace
 
     def add(self, part: WrittenPiece) -> None:
         self.whole.add(part.summary)
