@@ -21,7 +21,7 @@ Runs, all in one invocation:
   one fresh process (:func:`clpc.workflows.track_file`: the Parquet trace file, the summary,
   the figures and ``report.html``; warmed up on a short record first, so the plotting
   imports are not timed), against ``clpc track ... --workers N`` on the same cluster
-  (``clpc_track N``: :func:`clpc.distributed.long_track.track_settings`, i.e.
+  (``clpc_track N``: :func:`clpc.distributed.track_command.track_settings`, i.e.
   ``track_long`` then the same report, warmed up the same way).
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
@@ -55,6 +55,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import itertools
 import json
 import os
 import resource
@@ -131,6 +132,46 @@ def single_track(path: str, repeat: int) -> dict[str, Any]:
     return {"wall": best[0], "cpu": best[1], "updates": result.summary["updates"]}
 
 
+def single_long(path: str, repeat: int, parts: int = 6) -> dict[str, Any]:
+    """``track_long``'s work in this process (call it in a fresh one), one step after another.
+
+    ``CLPC().run`` on the record in memory, its trace written as ``parts`` Parquet files
+    as the workers write them (:func:`clpc.distributed.part_file.write_part`), and the
+    summary scanned from the same arrays as ``track_long``'s client scans
+    (:class:`clpc.appraiser.scanned.ScannedTrace`, :func:`clpc.report.trace_summary`): the
+    like-with-like reference of ``track_long``.
+    """
+    import dataclasses
+
+    from clpc import CLPC
+    from clpc.appraiser.scanned import ScannedTrace
+    from clpc.distributed.long_track import SUMMARY_KEYS
+    from clpc.distributed.part_file import write_part
+    from clpc.report import trace_summary
+
+    data = np.load(path)
+    u, y = np.ascontiguousarray(data[:, 0]), np.ascontiguousarray(data[:, 1])
+    del data
+    CLPC().run(u[:20_000], y[:20_000])  # warm-up: the compiled kernel loaded
+    best = (np.inf, np.inf)
+    with tempfile.TemporaryDirectory() as tmpdir:
+        for i in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            trace = CLPC().run(u, y)
+            scanned = ScannedTrace(Path(tmpdir))
+            cuts = np.linspace(0, len(trace), parts + 1).astype(int)
+            for k, (lo, hi) in enumerate(itertools.pairwise(cuts)):
+                rows = trace.view(lo, hi)
+                write_part(rows, Path(tmpdir) / f"out{i}" / f"part-{k:06d}.parquet")
+                keep = {key: v for key, v in rows.arrays.items() if key in SUMMARY_KEYS}
+                scanned.add(dataclasses.replace(rows, arrays=keep))
+            summary = trace_summary(scanned)
+            scanned.close()
+            del trace
+            best = min(best, (time.perf_counter() - t0, time.process_time() - c0))
+    return {"wall": best[0], "cpu": best[1], "updates": summary["updates"]}
+
+
 def single(path: str, repeat: int) -> dict[str, Any]:
     """The single-process run (in this process: call it in a fresh one)."""
     from clpc import CLPC
@@ -185,8 +226,8 @@ def distributed_runs(
 
     from clpc import CLPC
     from clpc.distributed import dask_client, run_long, track_long
-    from clpc.distributed.long_track import track_settings
     from clpc.distributed.sources import NpySource
+    from clpc.distributed.track_command import track_settings
 
     source = NpySource(path, (0,), (1,))
     warm = tmp / "warm.npy"
@@ -262,16 +303,24 @@ def distributed_runs(
     return rows
 
 
+def _ratios(row: dict[str, Any], ref: dict[str, Any]) -> str:
+    """The run's speed-ups: against ``CLPC.run``, and like with like for the written trace."""
+    wall = row["wall"]
+    if row["mode"] == "clpc_track":  # like with like: against clpc track in one process
+        return f"{ref['track']['wall'] / wall:5.2f}x clpc track"
+    out = f"{ref['wall'] / wall:5.2f}x CLPC.run"
+    if row["mode"] == "track_long":  # and against the same work done in one process
+        out += f", {ref['long']['wall'] / wall:5.2f}x its work in one process"
+    return out
+
+
 def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     secs, wall = row["seconds"], row["wall"]
-    if row["mode"] == "clpc_track":  # like with like: against clpc track in one process
-        ref = ref["track"]
     info = secs.get("piece_info", 0.0)
-    finish = secs.get("finish_piece", 0.0) + secs.get("write_piece", 0.0)
+    finish = sum(secs.get(k, 0.0) for k in ("finish_piece", "write_piece", "write_shared_piece"))
     print(
         f"{row['mode']:10s} {row['workers']} worker(s): wall {wall:7.2f} s  "
-        f"{n / wall:10.3g} samples/s  speed-up {ref['wall'] / wall:5.2f}x "
-        f"(vs {'clpc track' if row['mode'] == 'clpc_track' else 'CLPC.run'})  "
+        f"{n / wall:10.3g} samples/s  speed-up {_ratios(row, ref)}  "
         f"equal to single: {row['equal']}"
     )
     print(
@@ -296,7 +345,11 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="repetitions of each run (best kept)")
     parser.add_argument("--single-worker", nargs=2, help=argparse.SUPPRESS)
     parser.add_argument("--single-track", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--single-long", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.single_long:
+        print(json.dumps(single_long(args.single_long[0], int(args.single_long[1]))))
+        return
     if args.single_worker:
         print(json.dumps(single(args.single_worker[0], int(args.single_worker[1]))))
         return
@@ -315,9 +368,11 @@ def main() -> None:
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
         singles: list[dict[str, Any]] = []
         tracks: list[dict[str, Any]] = []
+        longs: list[dict[str, Any]] = []
+        flags = (("--single-worker", singles), ("--single-track", tracks), ("--single-long", longs))
 
         def references() -> None:  # one run of each, each in a fresh process
-            for flag, out in (("--single-worker", singles), ("--single-track", tracks)):
+            for flag, out in flags:
                 cmd = [sys.executable, __file__, flag, str(path), "1"]
                 done = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
                 out.append(json.loads(done.stdout))
@@ -327,6 +382,10 @@ def main() -> None:
         }
         ref = min(singles, key=lambda r: r["wall"])
         ref["track"] = track = min(tracks, key=lambda r: r["wall"])
+        ref["long"] = long = min(longs, key=lambda r: r["wall"])
+        print("\nevery run of the references (in order; one of each before each round):")
+        for name, runs in (("CLPC.run", singles), ("clpc track", tracks), ("its work", longs)):
+            print(f"  {name:10s} " + "  ".join(f"{r['wall']:.2f} s" for r in runs))
         print(
             f"\nsingle      wall {ref['wall']:7.2f} s  cpu {ref['cpu']:7.2f} s  "
             f"{n / ref['wall']:10.3g} samples/s  {ref['updates']} updates  "
@@ -337,10 +396,23 @@ def main() -> None:
             f"{n / track['wall']:10.3g} samples/s  {track['updates']} updates "
             f"(one process: Parquet trace file, summary, figures, report; best of {len(tracks)})"
         )
+        print(
+            f"its work    wall {long['wall']:7.2f} s  cpu {long['cpu']:7.2f} s  "
+            f"(track_long's work in one process: CLPC.run, Parquet parts, summary; best of "
+            f"{len(longs)})"
+        )
         for runs in rows.values():
             for row in runs:
                 if row["mode"] == "run_long":
                     row["equal"] = row["equal"] == ref["digests"]
+            print(f"\nevery run on {runs[0]['workers']} worker(s), against the best references:")
+            for row in runs:
+                cpu = row["client_cpu"] + sum(row["worker_cpu"])
+                print(
+                    f"  {row['mode']:10s} wall {row['wall']:5.2f} s  CPU {cpu:5.2f} s "
+                    f"(client {row['client_cpu']:.2f})  {_ratios(row, ref)}"
+                )
+            print("best of each:")
             for mode in MODES:
                 _show(min((r for r in runs if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
     print(f"\nload average after: {os.getloadavg()}")

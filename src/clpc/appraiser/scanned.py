@@ -88,12 +88,12 @@ class ScannedTrace:
         c["not_enough_data"] += int(np.sum(part.not_enough_data))
         c["lacking"] += int((a["n_input_relations"] > 0).any(axis=1).sum())
         self.D_last = a["D"][-1].copy()
-        if self._labels is None:
-            self._labels = part.take(slice(-1, None))
+        if self._labels is None:  # copies (an index array): the part's memory is let go
+            self._labels = part.take(np.arange(len(part) - 1, len(part)))
         recent = (
             part if self.last is None or len(part) >= RECENT else Trace.concat([self.last, part])
         )
-        self.last = recent if len(recent) <= RECENT else recent.take(slice(-RECENT, None))
+        self.last = recent.take(np.arange(max(len(recent) - RECENT, 0), len(recent)))
         self._conv = None
 
     def __len__(self) -> int:

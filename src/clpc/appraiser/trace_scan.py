@@ -170,11 +170,10 @@ class ScanState:
         if "trusted" in a:
             self.trusted = (self.trusted or 0) + int(a["trusted"].all(axis=1).sum())
         self._fallbacks(acc, model, theta, c)
-        quiet = self._quiet(acc, theta, d)
         rows = {"theta": theta, "D": d, "c": c, "acc": acc}
         rows["index"], rows["time"] = np.asarray(part.index), np.asarray(part.time, dtype=float)
-        if self.start < 0:
-            self._search(quiet, rows)
+        if self.start < 0:  # the quiet updates matter until the convergence point is found
+            self._search(self._quiet(acc, theta, d), rows)
         else:
             self._accumulate(rows)
         self.n += m

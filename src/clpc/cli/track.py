@@ -92,7 +92,7 @@ def _print_result(result: TrackResult) -> None:
 
 def _track_distributed(settings: TrackSettings, workers: int | None, scheduler: str | None) -> None:
     """The record split into pieces on a Dask cluster (``docs/distributed-long.md``)."""
-    from clpc.distributed.long_track import track_settings
+    from clpc.distributed.track_command import track_settings
     from clpc.io import save_model
     from clpc.workflows.save_check import save_refusal
 

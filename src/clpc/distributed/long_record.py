@@ -133,8 +133,13 @@ class _Joined:
         self.done = 0
         self.levels: list[np.ndarray] = []
 
-    def settle(self, piece: Piece, info: PieceInfo, state: FsmTuple) -> _InPlace:
-        """Finish a piece the workers wrote into the shared trace (in this process's map)."""
+    def settle(
+        self, piece: Piece, info: PieceInfo, state: FsmTuple, worker: str | None = None
+    ) -> _InPlace:
+        """Finish a piece the workers wrote into the shared trace (in this process's map).
+
+        ``worker``: the one that solved it (not needed: nothing is left to do there).
+        """
         assert self.mapped is not None
         lo, hi = piece.j_lo - 1, piece.j_hi
         c = self.mapped.extra[0][lo:hi]

@@ -43,14 +43,14 @@ from clpc.distributed.part_file import WrittenPiece, write_piece
 from clpc.distributed.piece_tasks import RecordPlan
 from clpc.distributed.pieces import warmup
 from clpc.distributed.schedule import run_pieces
-from clpc.distributed.sources import NpySource, ParquetSource, open_source
+from clpc.distributed.shared_rows import SharedRows
+from clpc.distributed.shared_track import SharedPieces
+from clpc.distributed.sources import NpySource, ParquetSource
 from clpc.model import LinearModel
 from clpc.report import steady_state, trace_summary
-from clpc.workflows import TrackSettings
-from clpc.workflows.common import SettingsError
-from clpc.workflows.track_report import REPORT_SAMPLES, Appraised, TrackResult, write_report
+from clpc.workflows.track_report import REPORT_SAMPLES, Appraised
 
-__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long", "track_settings"]
+__all__ = ["SUMMARY_KEYS", "LongTrack", "track_long"]
 
 #: the last updates the report's table shows (as ``clpc track``'s)
 RECENT = 20
@@ -87,6 +87,10 @@ class LongTrack:
         The folder of the trace's Parquet parts.
     parts : int
         Pieces (files of the dataset).
+    in_place : int
+        Of them, the pieces whose rows the workers wrote into the record's trace in shared
+        memory, settled there by the client (:mod:`clpc.distributed.shared_track`); the
+        others' rows were settled by their workers and what the report needs sent back.
     appraised : Appraised
         What a report is made of (:func:`clpc.workflows.track.write_report`).
     """
@@ -96,6 +100,7 @@ class LongTrack:
     model_source: str
     dataset: Path
     parts: int
+    in_place: int
     appraised: Appraised
 
     def close(self) -> None:
@@ -163,12 +168,27 @@ def track_long(
         )
     staging = folder / f".trace-{uuid.uuid4().hex}"
     stride = thinning_stride(total, figure_updates)
-    finish = (write_piece, (str(staging.resolve()), SUMMARY_KEYS, (stride, RECENT)))
+    thinning = (SUMMARY_KEYS, (stride, RECENT))
+    finish = (write_piece, (str(staging.resolve()), *thinning))
     taken = _Taken(ScannedTrace(Path(tempfile.gettempdir())))
+    # the trace in shared memory, each window's own c beside it (None: the rows are sent)
+    made = SharedRows.create(plan.state().empty_trace(), total, ((channels[1],),))
     try:
         with dask_client(client, scheduler, workers) as dask:
-            _, peaks = run_pieces(dask, plan, source, piece_samples, finish, sink=taken.add)
-            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False).result()
+            tail = dask.submit(tail_samples, source, plan, REPORT_SAMPLES, pure=False)
+            in_place, settled = None, 0
+            if made is not None:
+                in_place = SharedPieces(dask, plan, made, finish[1][0], thinning, taken.add)
+            _, peaks = run_pieces(
+                dask, plan, source, piece_samples, finish,
+                sink=taken.add if in_place is None else in_place.take,
+                shared=None if made is None else made[0],
+                local=None if in_place is None else in_place.finish,
+            )  # fmt: skip
+            if in_place is not None:
+                in_place.wait()
+                settled = in_place.pieces
+            tail = tail.result()
         check_peaks(appraiser, peaks, channels[0])
         summary = trace_summary(taken.whole)
         _replace(staging, folder / "trace")
@@ -179,6 +199,8 @@ def track_long(
         raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+        if made is not None:
+            made[0].remove()
     figures = gather(taken.figures)
     figures = dataclasses.replace(
         figures, meta=dict(figures.meta, thinned_stride=stride, updates_total=total)
@@ -187,7 +209,8 @@ def track_long(
     recent = last.take(np.arange(max(len(last) - RECENT, 0), len(last)))
     n_kept = plan.layout.kept(plan.n_raw)
     done = Appraised(appraiser.config(), n_kept, figures, taken.whole, recent, tail)
-    return LongTrack(summary, model, model_source, folder / "trace", taken.parts, done)
+    parts = (taken.parts, settled)
+    return LongTrack(summary, model, model_source, folder / "trace", *parts, done)
 
 
 class _Taken:
@@ -230,57 +253,6 @@ def tail_samples(source: NpySource | ParquetSource, plan: RecordPlan, n: int) ->
     raw = source.read(lo, plan.n_raw)
     kept = Decimator(lay.factor)(raw) if lay.factor > 1 else raw
     return np.array(kept[first - lo // lay.factor :], dtype=np.float64)
-
-
-def track_settings(
-    settings: TrackSettings,
-    *,
-    client: Any = None,
-    scheduler: str | None = None,
-    workers: int | None = None,
-) -> tuple[TrackResult, LongTrack]:
-    """``clpc track`` with ``--workers``/``--scheduler``: :func:`track_long`, then the report.
-
-    The record, its columns, ``--dt``, the appraiser's settings and ``--out`` are those of
-    the command; ``OUT`` gets ``trace/`` (the dataset), ``summary.json``, the figures and
-    ``report.html`` of :func:`clpc.workflows.track.write_report`.
-
-    Raises
-    ------
-    SettingsError
-        A time column (give ``--dt``), or a file that is not ``.npy`` or Parquet.
-    """
-    record = settings.record
-    if record.time_col is not None:
-        raise SettingsError(
-            "a record split over workers needs a uniform sample time given with --dt "
-            "(a time column is checked chunk by chunk on one machine: drop --workers/"
-            "--scheduler, or give --dt instead of --time)."
-        )
-    try:
-        keys = record.columns()  # digits as 0-based positions, as clpc track reads them
-        n_in, n_out = len(record.inputs), len(record.outputs)
-        source = open_source(record.file, tuple(keys[:n_in]), tuple(keys[n_in : n_in + n_out]))
-    except DataError as exc:
-        raise SettingsError(str(exc)) from None
-    done = track_long(
-        settings.appraiser.build(record.dt),
-        source,
-        settings.out_dir,
-        dt=record.dt,
-        client=client,
-        scheduler=scheduler,
-        workers=workers,
-        figure_updates=settings.figure_updates,
-    )
-    out = Path(settings.out_dir)
-    try:
-        result = write_report(settings, done.appraised, done.dataset, out)
-    finally:
-        done.close()
-    write_file(out / "summary.json", json.dumps(result.summary, indent=1))
-    files = [*result.files, out / "summary.json"]
-    return dataclasses.replace(result, files=files), done
 
 
 def _replace(new: Path, target: Path) -> None:

@@ -83,7 +83,7 @@ def run_pieces(
     finish: tuple[Callable[..., Any], tuple[Any, ...]] = (finish_piece, ()),
     sink: Callable[[Any], None] | None = None,
     shared: Any = None,
-    local: Callable[[Piece, PieceInfo, Any], Any] | None = None,
+    local: Callable[[Piece, PieceInfo, Any, str | None], Any] | None = None,
 ) -> tuple[list[Any], np.ndarray]:
     """Run every piece of a record on ``client``.
 
@@ -105,8 +105,10 @@ def run_pieces(
         The record's trace in shared memory, for the solves
         (:func:`.piece_tasks.solve_piece`).
     local : callable, optional
-        ``local(piece, info, state)``: the finish of a piece whose rows are in the shared
-        trace (``info.shared``), done by the client itself in its map of it (no task).
+        ``local(piece, info, state, worker)``: the finish of a piece whose rows are in the
+        shared trace (``info.shared``), done by the client itself in its map of it (no
+        finish task); ``worker``: the address of the worker that solved it (``None``:
+        unknown).
 
     Returns
     -------
@@ -158,7 +160,7 @@ def run_pieces(
             while after in solved:  # in time order: the record's state before each piece
                 fut, part, where = solved.pop(after)
                 if local is not None and part.shared:  # the rows are in the shared trace
-                    finishing.append(_Done(local(pieces[after], part, state)))
+                    finishing.append(_Done(local(pieces[after], part, state, where)))
                     ending.append(fut)  # released once its task has ended
                 else:
                     finishing.append(_finish(client, fut, (plan, state, where), finish))

@@ -85,6 +85,7 @@ class Mapped(NamedTuple):
 
     trace: Trace
     extra: list[np.ndarray]  #: (rows, ...) float64 each, as laid out by ``extra`` of create
+    buf: mmap.mmap  #: the map itself
 
 
 @dataclass(frozen=True)
@@ -158,7 +159,7 @@ class SharedRows:
         views = _Views(buf, self.slots)
         trace = Trace.allocate(like, self.rows, empty=views)
         extra = [views(shape, kind) for shape, kind, _ in self.slots[len(views.slots) :]]
-        return Mapped(trace, extra)
+        return Mapped(trace, extra, buf)
 
     def open(self, like: Trace, rows: tuple[int, int]) -> Mapped | None:
         """The shared file mapped in this process, rows ``rows`` reserved.
@@ -184,6 +185,25 @@ class SharedRows:
             os.close(fd)
         return self._mapped(like, buf)
 
+    def read(self, like: Trace) -> Mapped | None:
+        """The shared file mapped in this process for reading (no claim, nothing reserved).
+
+        ``like``: a trace of the record's appraiser. The arrays are read-only views of a
+        map of the file, kept as long as they are. ``None``: this process does not see the
+        file (another machine, or another ``/dev/shm``).
+        """
+        try:
+            fd = os.open(self.path, os.O_RDONLY)
+        except OSError:
+            return None
+        try:
+            if os.fstat(fd).st_size != self.size:
+                return None
+            buf = mmap.mmap(fd, self.size, prot=mmap.PROT_READ)
+        finally:
+            os.close(fd)
+        return self._mapped(like, buf)
+
     def reserve(self, rows: tuple[int, int]) -> None:
         """Reserve rows ``rows = (start, stop)`` for writing through an existing map.
 
@@ -202,12 +222,32 @@ class SharedRows:
         finally:
             os.close(fd)
 
+    def release(self, mapped: Mapped, rows: tuple[int, int]) -> None:
+        """Give the memory of rows ``rows = (start, stop)`` back (their values become 0).
+
+        Every page of the file that lies within those rows of an array is removed from the
+        tmpfs (``madvise(MADV_REMOVE)`` through ``mapped``, this process's map); pages
+        shared with the rows before or after are kept. Call it once nobody reads the rows
+        any more (e.g. they are written elsewhere).
+        """
+        page = mmap.PAGESIZE
+        for lo, hi in self._spans(rows):
+            first, last = -(-lo // page) * page, hi // page * page
+            if last > first:
+                mapped.buf.madvise(mmap.MADV_REMOVE, first, last - first)
+
+    def _spans(self, rows: tuple[int, int]) -> list[tuple[int, int]]:
+        """The byte ranges ``[lo, hi)`` of rows ``rows`` in every array of the file."""
+        out = []
+        for shape, kind, offset in self.slots:
+            per_row = math.prod(shape[1:]) * np.dtype(kind).itemsize
+            out.append((offset + rows[0] * per_row, offset + rows[1] * per_row))
+        return out
+
     def _reserve(self, fd: int, rows: tuple[int, int]) -> bool:
         """Allocate the pages of rows ``rows`` of every array (False: no room)."""
         try:
-            for shape, kind, offset in self.slots:
-                per_row = math.prod(shape[1:]) * np.dtype(kind).itemsize
-                lo, hi = offset + rows[0] * per_row, offset + rows[1] * per_row
+            for lo, hi in self._spans(rows):
                 if hi > lo:
                     os.posix_fallocate(fd, lo, hi - lo)
         except OSError:

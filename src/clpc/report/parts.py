@@ -13,6 +13,7 @@ from typing import Any
 from clpc.core.rules import MIN_HELDOUT_FIT
 from clpc.model import LinearModel, fit_verdict
 from clpc.plotting import plot_bode, plot_data, plot_fit, plot_pz, plot_step
+from clpc.report.drawing import Drawing
 from clpc.report.html import Section
 from clpc.report.summaries import model_summary
 from clpc.report.text import format_fit, format_model_summary
@@ -92,21 +93,29 @@ BODE_PNG, PZ_PNG = "bode.png", "pz.png"
 
 
 def draw_model_figures(
-    model: LinearModel, out: Path, *, data: Any = None, data_t0: float = 0.0
+    model: LinearModel,
+    out: Path,
+    *,
+    data: Any = None,
+    data_t0: float = 0.0,
+    draw: Drawing | None = None,
 ) -> None:
-    """Draw the figures of :func:`model_sections`, one after the other.
+    """Draw the figures of :func:`model_sections`.
 
     ``fit.png`` and ``data.png`` (with ``data``), ``step.png``, ``bode.png``, ``pz.png`` in
     ``out``. Long records are drawn as min/max envelopes (see
     :data:`clpc.core.figure.MAX_POINTS`), so each figure costs about the same at any length.
+    ``draw``: where (:class:`clpc.report.drawing.Drawing`; default one after the other,
+    here); the caller waits for it.
     """
+    draw = Drawing() if draw is None else draw
     if data is not None:
         title = f"the compared {data.n_samples} samples"
-        plot_fit(model, data, out / FIT_PNG, t0=data_t0)
-        plot_data(data, out / DATA_PNG, t0=data_t0, title=title)
-    plot_step(model, out / STEP_PNG)
-    plot_bode(model, out / BODE_PNG)
-    plot_pz(model, out / PZ_PNG)
+        draw(plot_fit, model, data, out / FIT_PNG, t0=data_t0)
+        draw(plot_data, data, out / DATA_PNG, t0=data_t0, title=title)
+    draw(plot_step, model, out / STEP_PNG)
+    draw(plot_bode, model, out / BODE_PNG)
+    draw(plot_pz, model, out / PZ_PNG)
 
 
 def model_sections(
@@ -117,6 +126,7 @@ def model_sections(
     data_note: str = "",
     data_t0: float = 0.0,
     summary: Mapping[str, Any] | None = None,
+    draw: Drawing | None = None,
 ) -> tuple[list[Section], list[Path]]:
     """Sections on a model: equations, measured vs model with residuals, step, Bode, poles.
 
@@ -134,6 +144,9 @@ def model_sections(
         Time of ``data``'s first sample in the whole record (the fit figure's time axis).
     summary : mapping, optional
         :func:`model_summary` of ``model`` on ``data``, when the caller has it already.
+    draw : Drawing, optional
+        Where the figures are drawn (default one after the other, here); a caller that
+        gives one waits for it (:meth:`clpc.report.drawing.Drawing.wait`).
 
     Returns
     -------
@@ -184,7 +197,7 @@ def model_sections(
             collapsed=True,
         )
     )
-    draw_model_figures(model, out, data=data, data_t0=data_t0)
+    draw_model_figures(model, out, data=data, data_t0=data_t0, draw=draw)
     return sections, files
 
 

@@ -9,7 +9,7 @@ updates and the settings.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -26,6 +26,7 @@ from clpc.plotting.track_quantities import (
     plot_track_quantities,
 )
 from clpc.plotting.window_tests import plot_window_tests
+from clpc.report.drawing import Drawing
 from clpc.report.html import Section, write_html_report
 from clpc.report.parts import fit_warnings, model_sections, model_warnings, settings_section
 from clpc.report.summaries import model_summary
@@ -138,6 +139,7 @@ def write_track_report(
     steady: tuple[Any, str] | None = None,
     recent: Trace | None = None,
     rule: RobustRule | None = None,
+    submit: Callable[..., Any] | None = None,
 ) -> list[Path]:
     """Figures and an HTML report of a CLPC trace.
 
@@ -175,6 +177,12 @@ def write_track_report(
         in ``tests.png`` (:func:`clpc.plotting.window_tests.plot_window_tests`) when fewer
         than :data:`~clpc.appraiser.convergence.MIN_TRUSTED_FRACTION` of the updates were
         accepted.
+    submit : callable, optional
+        ``submit(function, *args, **kwargs) -> future``: the figures, which are
+        independent, are handed to it at once, and the report is written when every one
+        is drawn (:class:`clpc.report.drawing.Drawing`; e.g. a Dask cluster's workers, see
+        :class:`clpc.distributed.cluster_submit.ClusterSubmit`). Default: drawn one after
+        the other in this process. The files are the same either way.
 
     Returns
     -------
@@ -182,6 +190,7 @@ def write_track_report(
         The files written (the report last).
     """
     out = Path(out_dir)
+    draw = Drawing(submit)
     model, source = steady_state(trace) if steady is None else steady
     trace_png = out / "trace.png"
     summary = trace_summary(trace) if summary is None else summary
@@ -198,8 +207,10 @@ def write_track_report(
         table=_result_table(trace, summary),
     )
     sections = [result]
+    # the trace's figure first: the longest to draw, so with submit it is not left for last
+    draw(plot_trace, trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     quantities_png = out / "quantities.png"
-    plot_track_quantities(trace, quantities_png)
+    draw(plot_track_quantities, trace, quantities_png)
     files: list[Path] = [quantities_png]
     sections.append(_quantities_section(trace, quantities_png))
     if model is not None:
@@ -210,6 +221,7 @@ def write_track_report(
             data_note=data_note,
             data_t0=data_t0,
             summary=fitted,
+            draw=draw,
         )
         more[0].heading = f"Model: {source}"
         sections += more
@@ -217,14 +229,13 @@ def write_track_report(
     n = max(int(summary["updates"]), 1)
     if int(summary["accepted"]) < MIN_TRUSTED_FRACTION * n:
         tests_png = out / "tests.png"
-        plot_window_tests(trace, tests_png, rule=rule)
+        draw(plot_window_tests, trace, tests_png, rule=rule)
         files.append(tests_png)
         sections.append(_tests_section(tests_png, rule or RobustRule()))
         if model is None:
             result.text = "The window tests below show why no estimate was accepted."
     if summary.get("advice"):
         result.text = "\n\n".join(t for t in (summary["advice"], result.text) if t)
-    plot_trace(trace, trace_png, title=f"CLPC trace: {len(trace)} updates")
     files.append(trace_png)
     sections.append(
         Section(
@@ -243,5 +254,6 @@ def write_track_report(
     rows += [[row[i] for i in keep] for row in values[-20:]]
     sections.append(Section(f"Last {len(rows) - 1} updates", table=rows, collapsed=True))
     sections.append(settings_section(settings or {}))
+    draw.wait()  # the page after its figures
     files.append(write_html_report(out / "report.html", title, sections))
     return files

@@ -8,6 +8,7 @@ or after a record was appraised on a cluster (:mod:`clpc.distributed.long_track`
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -135,7 +136,13 @@ def _report_data(done: Appraised, trace: Any) -> dict[str, Any]:
     return {"data": data, "data_note": note, "data_t0": t0}
 
 
-def write_report(settings: Any, done: Appraised, trace_file: Path, out: Path) -> TrackResult:
+def write_report(
+    settings: Any,
+    done: Appraised,
+    trace_file: Path,
+    out: Path,
+    submit: Callable[..., Any] | None = None,
+) -> TrackResult:
     """Summary, steady-state model, figures and ``report.html`` of a tracked record.
 
     Parameters
@@ -148,6 +155,9 @@ def write_report(settings: Any, done: Appraised, trace_file: Path, out: Path) ->
         The trace written (listed first among the files).
     out : Path
         Folder for the figures and the report.
+    submit : callable, optional
+        Where the figures are drawn, all at once (see
+        :func:`clpc.report.write_track_report`); default one after the other, here.
 
     Returns
     -------
@@ -179,6 +189,7 @@ def write_report(settings: Any, done: Appraised, trace_file: Path, out: Path) ->
         steady=(model, source),
         recent=done.recent,
         rule=done.rule,
+        submit=submit,
         **shown,
     )
     fit = None
