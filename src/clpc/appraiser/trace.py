@@ -84,6 +84,9 @@ class Trace:
         return int(self.arrays["theta"].shape[1])
 
     def __getattr__(self, name: str) -> np.ndarray:
+        if "_view_of" in self.__dict__:  # a view of lazy_view: its arrays made now
+            self._materialise()
+            return getattr(self, name)
         arrays = self.__dict__.get("arrays")
         if arrays is not None and name in arrays:
             value = arrays[name]
@@ -181,6 +184,44 @@ class Trace:
         for f in _FIELD_NAMES - values.keys():
             values[f] = getattr(self, f)
         return Trace.of(values)
+
+    def lazy_view(self, start: int, stop: int) -> Trace:
+        """:meth:`view`, its per-row arrays sliced on first use (``step``'s update).
+
+        A view slices some 25 arrays (about 10 us); ``step`` returns its update as a view of
+        a block of rows, and a caller that never reads it should not pay for the slicing.
+        The labels (``structure``, names, ``meta`` - a copy) are set at once; reading any
+        other attribute makes the view (:meth:`view`, the same arrays) and keeps it.
+
+        Parameters
+        ----------
+        start, stop : int
+            The rows, as in a slice.
+        """
+        trace = object.__new__(Trace)
+        values = trace.__dict__
+        for f in _LABEL_FIELDS:
+            values[f] = self.__dict__[f]
+        values["meta"] = dict(self.meta)
+        values["_view_of"] = (self, start, stop)
+        return trace
+
+    def _materialise(self) -> None:
+        """Slice the arrays of a :meth:`lazy_view` (idempotent)."""
+        values = self.__dict__
+        source = values.get("_view_of")
+        if source is None:
+            return
+        block, start, stop = source
+        view = block.view(start, stop).__dict__
+        for f in (*_ROW_FIELDS, "arrays"):
+            values[f] = view[f]
+        values.pop("_view_of", None)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields for pickling (a :meth:`lazy_view` is sliced first: not its block)."""
+        self._materialise()
+        return self.__dict__
 
     def put(self, start: int, part: Trace) -> int:
         """Copy the rows of ``part`` into rows ``start ..``; returns the row after them.
@@ -298,3 +339,5 @@ class Trace:
 _FIELD_NAMES = {f.name for f in fields(Trace)}
 #: the fields with one row per update besides ``arrays``
 _ROW_FIELDS = ("index", "time", "rows", "not_enough_data")
+#: the fields that are the same for every row (besides ``meta``, copied per trace)
+_LABEL_FIELDS = tuple(sorted(_FIELD_NAMES - {*_ROW_FIELDS, "arrays", "meta"}))
