@@ -76,7 +76,8 @@ class Trace:
     meta: dict[str, Any] = field(default_factory=dict)
 
     def __len__(self) -> int:
-        return int(self.index.shape[0])
+        lazy = self.__dict__.get("_view_of")  # a lazy_view: counted without slicing
+        return lazy[2] - lazy[1] if lazy is not None else int(self.index.shape[0])
 
     @property
     def n_equations(self) -> int:
