@@ -59,6 +59,15 @@ class SampleBuffer:
             self._hi += n
             self.pending = []
 
+    def flushed(self) -> tuple[np.ndarray, int]:
+        """:meth:`flush`, then the whole store and the absolute index of its first row.
+
+        The store holds the live rows (and rows forgotten or not yet written around them,
+        never to be read): a kernel reading sample ``k`` at row ``k - index`` needs no view.
+        """
+        self.flush()
+        return self._store, self.start - self._lo
+
     def append(self, new: np.ndarray) -> None:
         """Append decimated samples (after the pending ones)."""
         self.flush()

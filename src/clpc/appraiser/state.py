@@ -225,11 +225,21 @@ class AppraiserState:
         return self._take_aside()
 
     def _take_aside(self) -> Trace:
-        """The samples kept aside into the buffer, and the one update they close."""
-        assert self.buffer is not None
-        self.buffer.flush()
-        trace = self._one_update()
-        self._forget()
+        """The samples kept aside into the buffer, and the one update they close.
+
+        :meth:`consume` of them, unrolled for the one update (``step``'s path): the
+        buffer's whole store goes to the kernel (no view made), then the rows no later
+        window needs are forgotten (:meth:`_forget`).
+        """
+        buf = self.buffer
+        assert buf is not None
+        store, first = buf.flushed()
+        j = self.j_done + 1
+        stepper = self.stepper or self._stepper()
+        trace = stepper.update(store, first - self.max_lag, j)
+        self.j_done = j
+        c = self.cluster
+        buf.drop_before(c * (j + 1) - self.settings.window_size - c)
         return trace
 
     def consume(self, new: np.ndarray, mapper: Callable[..., Any] = map) -> Trace:
@@ -289,7 +299,7 @@ class AppraiserState:
         assert buf is not None
         j = self.j_done + 1
         stepper = self.stepper or self._stepper()
-        trace = stepper.update((buf.data, buf.start - self.max_lag), j)
+        trace = stepper.update(buf.data, buf.start - self.max_lag, j)
         self.j_done = j
         return trace
 

@@ -50,7 +50,8 @@ class StepUpdates:
         self._packed = pack_state(setup, *state)
         self._labels = labels
         self._max_lag, self._cluster = rows
-        self._out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        #: the arguments of update_row after the row: the packed state, the block's arrays
+        self._args: tuple[np.ndarray, ...] = ()
         self._block: Trace | None = None
         self._j0 = 0  #: the update of the block's row 0
         self._next = ROWS  #: the block's first row not written yet
@@ -59,14 +60,16 @@ class StepUpdates:
         """The carried FSM state and the block cache: views of the packed state."""
         return state_views(self._packed)
 
-    def update(self, samples: tuple[np.ndarray, int], j: int) -> Trace:
+    def update(self, samples: np.ndarray, first_row: int, j: int) -> Trace:
         """Update ``j``: solved, written into its row, returned as a one-row trace.
 
         Parameters
         ----------
-        samples : (ndarray, int)
-            The buffered samples (n, channels) and the absolute lag row of the first (as
-            for :func:`clpc.appraiser.kernel.update`).
+        samples : ndarray, shape (n, channels)
+            The buffered samples (C-contiguous).
+        first_row : int
+            The absolute lag row of ``samples[0]`` (as for
+            :func:`clpc.appraiser.kernel.solve_windows`).
         j : int
             The update (after the one before it; updates solved elsewhere may lie between).
 
@@ -79,12 +82,9 @@ class StepUpdates:
         if not self._next <= row < ROWS:
             self._new_block(j)
             row = 0
-        out = self._out
-        assert out is not None and self._block is not None
-        fl, ints, flags = self._packed
-        update_row(samples[0], samples[1], j, row, fl, ints, flags, out[0], out[1], out[2])
+        update_row(samples, first_row, j, row, *self._args)
         self._next = row + 1
-        return self._block.lazy_view(row, row + 1)
+        return self._block.lazy_view(row, row + 1)  # type: ignore[union-attr]
 
     def _new_block(self, j0: int) -> None:
         """A block for updates ``j0 .. j0 + ROWS - 1`` (their sample indices filled in)."""
@@ -93,4 +93,4 @@ class StepUpdates:
         arrays = {key: views[key] for key in PER_EQUATION}
         arrays["not_enough"] = views["not_enough"]
         self._block = self._labels.trace(index, views["rows"], arrays)
-        self._out, self._j0, self._next = out, j0, 0
+        self._args, self._j0, self._next = (*self._packed, *out), j0, 0

@@ -6,6 +6,7 @@ are made: :class:`~clpc.appraiser.trace_labels.TraceLabels`.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
@@ -201,8 +202,7 @@ class Trace:
         """
         trace = object.__new__(Trace)
         values = trace.__dict__
-        for f in _LABEL_FIELDS:
-            values[f] = self.__dict__[f]
+        values.update(zip(_LABEL_FIELDS, _labels_of(self.__dict__), strict=True))
         values["meta"] = dict(self.meta)
         values["_view_of"] = (self, start, stop)
         return trace
@@ -342,3 +342,4 @@ _FIELD_NAMES = {f.name for f in fields(Trace)}
 _ROW_FIELDS = ("index", "time", "rows", "not_enough_data")
 #: the fields that are the same for every row (besides ``meta``, copied per trace)
 _LABEL_FIELDS = tuple(sorted(_FIELD_NAMES - {*_ROW_FIELDS, "arrays", "meta"}))
+_labels_of = operator.itemgetter(*_LABEL_FIELDS)
