@@ -214,9 +214,10 @@ class Trace:
         if source is None:
             return
         block, start, stop = source
-        view = block.view(start, stop).__dict__
-        for f in (*_ROW_FIELDS, "arrays"):
-            values[f] = view[f]
+        of = block.__dict__
+        for f in _ROW_FIELDS:  # as view() slices them, without a trace in between
+            values[f] = of[f][start:stop]
+        values["arrays"] = {k: v[start:stop] for k, v in of["arrays"].items()}
         values.pop("_view_of", None)
 
     def __getstate__(self) -> dict[str, Any]:
