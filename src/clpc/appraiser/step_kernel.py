@@ -3,13 +3,14 @@
 A call of a ``numba`` function unboxes every array it is given, about 0.1 us each on this
 machine, and a nested or mixed tuple costs several times more (``benchmarks/README.md``,
 issue 26). :func:`clpc.appraiser.kernel.update_windows` takes some 45 arrays, which is most
-of the cost of one ``step`` update. :func:`update_row` takes seven: the record's fixed
-settings, its carried state and its block cache packed once per record into one array per
-type (:func:`pack_state`), and the outputs of a block of :data:`ROWS` updates packed into one
-array per type (:func:`new_outputs`); it rebuilds the kernel's named tuples from views of
-them (no copies) and runs :func:`~clpc.appraiser.kernel.solve_windows` and
-:func:`~clpc.appraiser.kernel.fsm_output` on one window, as ``update_windows`` does: the
-same functions on the same numbers, so the same bits.
+of the cost of one ``step`` update. :func:`update_row` takes seven arrays and three
+integers: the record's fixed settings, its carried state and its block cache packed once
+per record into one array per type (:func:`pack_state`), and the outputs of a block of
+:data:`ROWS` updates packed into one array per type (:func:`new_outputs`); it rebuilds the
+kernel's named tuples from views of them (no copies) and runs
+:func:`~clpc.appraiser.kernel.solve_windows` and :func:`~clpc.appraiser.kernel.fsm_output`
+on one window, as ``update_windows`` does: the same functions on the same numbers, so the
+same bits.
 
 Layout: every part is a contiguous run of one of the packed arrays; the integer array starts
 with the record's sizes and settings (``_H_*``) and a table of each part's offset and size
@@ -59,7 +60,7 @@ _HEADER = 19
 (_FLOATS, _TRANSFORM, _THETA, _C, _C_MEAN, _C_SCAT, _C_STEP) = range(4, 11)  # float array
 _HAS_MODEL = 11  # in the bool array
 _N_STATE = 12
-# the outputs of a block, by type, in the fields' order of Solved and FsmOutput
+# the outputs of a block, by type (update_row maps them onto Solved's and FsmOutput's fields)
 FLOAT_OUT = (
     "theta_estimate", "eigenvalues", "theta", "c_solved", "noise_variance", "separation",
     "a0_weight", "c", "lambda_min", "lambda_max", "D", "eig_ratio", "J", "den", "num",
