@@ -252,6 +252,18 @@ def table(args: Any) -> str:
     t = cpu(stepped, repeat)
     per = t / n_step * 1e6
     row("step (Python floats), C=12", 6, (n_step - 2) // 12, t, ref12, f"{per:.2f} us/sample")
+
+    def stepped_read() -> None:  # an update's arrays are sliced when first read
+        a = clpc.CLPC(order=2, window_size=WINDOW, cluster_size=12)
+        f = a.step
+        for uk, yk in zip(ul, yl, strict=True):
+            part = f(uk, yk)
+            if len(part):
+                part.theta, part.D  # noqa: B018 - what a monitoring loop reads
+
+    t = cpu(stepped_read, repeat)
+    per = t / n_step * 1e6
+    row("step, theta and D read, C=12", 6, (n_step - 2) // 12, t, ref12, f"{per:.2f} us/sample")
     ul1, yl1 = ul[:2000], yl[:2000]
 
     def stepped1() -> None:

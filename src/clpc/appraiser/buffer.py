@@ -7,8 +7,6 @@ the first kept sample. :meth:`clpc.CLPC.step` keeps scalar samples aside in ``pe
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 __all__ = ["SampleBuffer"]
@@ -28,11 +26,16 @@ class SampleBuffer:
     """
 
     def __init__(self, n_columns: int) -> None:
-        self._store = np.empty((0, n_columns))
-        self._lo = 0  # live rows are _store[_lo:_hi]
-        self._hi = 0
+        self._use(np.empty((0, n_columns)), 0, 0)
         self.start = 0
-        self.pending: list[Any] = []  # samples kept aside by step(): arrays or (u, y)
+        #: the values of samples kept aside by step(), row after row (plain floats)
+        self.pending: list[float] = []
+
+    def _use(self, store: np.ndarray, lo: int, hi: int) -> None:
+        """Keep the samples in ``store`` (C-contiguous), live rows ``lo .. hi - 1``."""
+        self._store = store
+        self._flat = store.reshape(-1)  # the same memory, one value after another
+        self._lo, self._hi = lo, hi
 
     @property
     def data(self) -> np.ndarray:
@@ -41,31 +44,45 @@ class SampleBuffer:
 
     @data.setter
     def data(self, values: np.ndarray) -> None:
-        self._store = np.array(values, dtype=np.float64, order="C")
-        self._lo, self._hi = 0, self._store.shape[0]
+        store = np.array(values, dtype=np.float64, order="C")
+        self._use(store, 0, store.shape[0])
 
     def flush(self) -> None:
-        """Move the samples kept aside into ``data``."""
-        if self.pending:
-            self.append(self.take_pending())
+        """Move the samples kept aside into ``data`` (their values copied straight in)."""
+        pending = self.pending
+        if pending:
+            n_columns = self._store.shape[1]
+            n = len(pending) // n_columns
+            self._reserve(n)
+            at = self._hi * n_columns
+            self._flat[at : at + len(pending)] = pending
+            self._hi += n
+            self.pending = []
+
+    def flushed(self) -> tuple[np.ndarray, int]:
+        """:meth:`flush`, then the whole store and the absolute index of its first row.
+
+        The store holds the live rows (and rows forgotten or not yet written around them,
+        never to be read): a kernel reading sample ``k`` at row ``k - index`` needs no view.
+        """
+        self.flush()
+        return self._store, self.start - self._lo
 
     def append(self, new: np.ndarray) -> None:
         """Append decimated samples (after the pending ones)."""
         self.flush()
         n = new.shape[0]
-        if self._hi + n > self._store.shape[0]:
-            live = self._hi - self._lo
-            store = np.empty((2 * (live + n), new.shape[1]))
-            store[:live] = self._store[self._lo : self._hi]
-            self._store, self._lo, self._hi = store, 0, live
+        self._reserve(n)
         self._store[self._hi : self._hi + n] = new
         self._hi += n
 
-    def take_pending(self) -> np.ndarray:
-        """The samples kept aside, as an array, removed from ``pending``."""
-        block = np.array(self.pending, dtype=np.float64).reshape(len(self.pending), -1)
-        self.pending = []
-        return block
+    def _reserve(self, n: int) -> None:
+        """Room for ``n`` more rows after the live ones (moved to the front if needed)."""
+        if self._hi + n > self._store.shape[0]:
+            live = self._hi - self._lo
+            store = np.empty((2 * (live + n), self._store.shape[1]))
+            store[:live] = self._store[self._lo : self._hi]
+            self._use(store, 0, live)
 
     def drop_before(self, sample: int) -> None:
         """Forget samples older than absolute index ``sample``."""

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from clpc.appraiser.feeding import feed_chunk, feed_record, feed_sample
-from clpc.appraiser.inputs import as_chunk
+from clpc.appraiser.inputs import SCALAR_TYPES, as_chunk
 from clpc.appraiser.runners import register_runner, runner_for
 from clpc.appraiser.saved_state import read_state, restored, saved_form, write_state
 from clpc.appraiser.settings import Settings, SettingsProperties
@@ -157,7 +157,10 @@ class CLPC(SettingsProperties):
         Trace
             One row when this sample closes a cluster (an update), else none.
         """
-        return feed_sample(self._state, u_k, y_k, self._map)
+        s = self._state
+        if s.plain_siso and type(u_k) in SCALAR_TYPES and type(y_k) in SCALAR_TYPES:
+            return s.keep_scalar(u_k, y_k)  # the common case, one call less
+        return feed_sample(s, u_k, y_k, self._map)
 
     def push(
         self, u: Any, y: Any, *, progress: Callable[[int, int, int], Any] | None = None

@@ -9,7 +9,6 @@ writes into its arrays). :class:`clpc.CLPC`'s ``step``, ``push`` and ``run`` are
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -42,8 +41,9 @@ Progress = Callable[[int, int, int], Any]
 def feed_sample(state: AppraiserState, u_k: Any, y_k: Any, mapper: Mapper) -> Trace:
     """One sample (:meth:`clpc.CLPC.step`); the update it produced (0 or 1 rows).
 
-    Samples that close no update are kept aside without array work where the record allows
-    (no decimation); else the sample is fed as a chunk of one.
+    Without decimation the sample is kept aside (plain floats; a scalar input and output
+    take :meth:`AppraiserState.keep_scalar`, which ``CLPC.step`` also calls directly) and
+    the update it closes is solved alone; else the sample is fed as a chunk of one.
 
     Parameters
     ----------
@@ -55,23 +55,18 @@ def feed_sample(state: AppraiserState, u_k: Any, y_k: Any, mapper: Mapper) -> Tr
         ``map`` of the batched solves.
     """
     s = state
+    if s.plain_siso and type(u_k) in SCALAR_TYPES and type(y_k) in SCALAR_TYPES:
+        return s.keep_scalar(u_k, y_k)  # plain floats, no arrays until the update
     rows_after = s.n_seen + 1 - s.max_lag
     update = rows_after > 0 and rows_after % s.cluster == 0
-    if s.plain_siso and type(u_k) in SCALAR_TYPES and type(y_k) in SCALAR_TYPES:
-        # single-channel scalars: plain floats, no arrays until the update
-        u_f, y_f = float(u_k), float(y_k)
-        if not (math.isfinite(u_f) and math.isfinite(y_f)):
-            check_finite(np.array([[u_f]]), "u", s.n_seen)
-            check_finite(np.array([[y_f]]), "y", s.n_seen)
-        return s.keep_aside((u_f, y_f), update, mapper)
     u = as_columns(u_k, "u").ravel()
     y = as_columns(y_k, "y").ravel()
-    if s.plain and u.shape == (s.n_in,) and y.shape == (s.n_out,) and not update:
+    if s.plain and u.shape == (s.n_in,) and y.shape == (s.n_out,):
         sample = np.concatenate([u, y])
         if not np.all(np.isfinite(sample)):
             check_finite(u[None], "u", s.n_seen)
             check_finite(y[None], "y", s.n_seen)
-        return s.keep_aside(sample, False, mapper)
+        return s.keep_aside(sample.tolist(), update)
     return feed_chunk(s, as_chunk(u[None, :], y[None, :], s.n_seen), mapper, None)
 
 

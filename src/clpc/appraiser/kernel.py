@@ -92,8 +92,6 @@ __all__ = [
     "settings_for",
     "solve_updates",
     "trace_outputs",
-    "update",
-    "update_one",
     "window_plan",
 ]
 
@@ -590,61 +588,10 @@ def settings_for(
 Plain = tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]
 
 
-def update(
-    samples: tuple[np.ndarray, int],
-    windows: tuple[int, int],
-    setup: KernelSetup,
-    state: tuple[FsmState, BlockCache],
-) -> Plain:
-    """Solve ``windows`` and run the FSM output over them in one kernel call.
-
-    Parameters
-    ----------
-    samples : (ndarray, int)
-        The buffered samples, shape (n, channels), and the absolute lag row of the first.
-    windows : (int, int)
-        ``(j0, count)``: updates ``j0 .. j0 + count - 1``.
-    setup : KernelSetup
-        The record's :class:`KernelSetup` (its ``plain`` settings go
-        to :func:`update_windows`).
-    state : (FsmState, BlockCache)
-        The carried :class:`FsmState` and the record's :class:`BlockCache` (both updated
-        in place).
-
-    Returns
-    -------
-    solved, output : tuple of ndarray
-        The fields of :class:`Solved` and of :class:`FsmOutput`, in order (plain tuples:
-        the hot path of ``step`` builds no named tuples).
-    """
-    solved, out = outputs(windows[1], setup)
-    fsm, cache = state
-    update_windows(
-        samples[0], samples[1], windows, setup.plain, tuple(fsm), (solved, out), tuple(cache)
-    )
-    return solved, out
-
-
-def update_one(
-    setup: KernelSetup,
-    samples: tuple[np.ndarray, int],
-    j: int,
-    state: tuple[FsmState, BlockCache],
-) -> dict[str, np.ndarray]:
-    """Update ``j`` alone (:func:`update` with one window): the arrays of its trace row.
-
-    The streaming path (``step``, small ``push`` chunks): one kernel call, no batching.
-    Returns the per-equation arrays of :data:`clpc.appraiser.trace.PER_EQUATION` plus
-    ``not_enough`` and ``n_rows``, each with one row.
-    """
-    return _arrays(*update(samples, (j, 1), setup, state))
-
-
 def outputs(count: int, setup: KernelSetup) -> Plain:
     """Uninitialised output arrays of ``count`` updates, as plain tuples (see :data:`Plain`).
 
-    Fields of the same shape and type share one allocation (a call of ``step`` allocates
-    them all for one update: their number is most of its cost).
+    Fields of the same shape and type share one allocation.
     """
     e, p = setup.plan.chan.shape
     fs = setup.fsm
@@ -674,7 +621,7 @@ def solve(
 
 
 def output(solved: Solved, setup: KernelSetup, state: FsmState) -> FsmOutput:
-    """The FSM output of ``solved`` from ``state`` (updated in place), as in :func:`update`."""
+    """The FSM output of ``solved`` from ``state`` (updated in place), as ``update_windows``."""
     out = FsmOutput(*outputs(solved.n_rows.shape[0], setup)[1])
     fsm_output(solved, setup.fsm, state, out)
     return out
@@ -777,12 +724,3 @@ _SOLVED_KEYS = (
     "n_rows",
 )
 _FSM_KEYS = tuple(FsmOutput._fields)
-
-
-def _arrays(solved: tuple[np.ndarray, ...], out: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
-    """The per-update arrays of a trace part, from the kernel's two outputs (plain tuples)."""
-    arrays = dict(zip(_FSM_KEYS, out, strict=True))
-    for key, value in zip(_SOLVED_KEYS, solved, strict=True):
-        if key is not None:
-            arrays[key] = value
-    return arrays

@@ -17,8 +17,10 @@ import numpy as np
 from clpc.appraiser import kernel
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator
+from clpc.appraiser.inputs import check_finite
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.state_schema import FORMAT, VERSION, digest
+from clpc.appraiser.step_block import StepUpdates
 from clpc.appraiser.trace import Trace
 from clpc.appraiser.trace_labels import TraceLabels
 from clpc.data import DataError
@@ -57,6 +59,7 @@ class AppraiserState:
     labels: TraceLabels | None = None
     empty: Trace | None = None
     blocks: kernel.BlockCache | None = None  #: statistics of the newest blocks (derived)
+    stepper: StepUpdates | None = None  #: step's updates (made on the first; derived)
 
     def __post_init__(self) -> None:
         self.max_lag = self.settings.structure.max_lag
@@ -157,6 +160,7 @@ class AppraiserState:
         self.buffer.start = start
         self.n_seen, self.j_done = counts
         self.last_theta, self.last_c, self.has_model = model
+        self.stepper = None  # its packed state holds the former values
         if record_dt is not None:
             self.record_dt = record_dt
 
@@ -188,17 +192,55 @@ class AppraiserState:
         kept = 0 if first >= n_samples else (n_samples - 1 - first) // f + 1
         return max(self.n_seen + kept - self.max_lag, 0) // self.cluster - self.j_done
 
-    def keep_aside(self, sample: Any, update: bool, mapper: Callable[..., Any]) -> Trace:
-        """Keep one undecimated sample aside (fast ``step``); solve when it closes an update."""
+    def keep_aside(self, sample: Any, update: bool) -> Trace:
+        """Keep one undecimated sample aside (``step``); solve when it closes an update.
+
+        ``sample``: its values (inputs, then outputs), floats; ``update``: it closes one.
+        """
         buf = self.buffer
         assert buf is not None
-        buf.pending.append(sample)
+        buf.pending.extend(sample)
         self.n_seen += 1
         if not update:
             return self.empty if self.empty is not None else self.empty_trace()
-        block = buf.take_pending()
-        self.n_seen -= block.shape[0]  # consume counts them
-        return self.consume(block, mapper)
+        return self._take_aside()
+
+    def keep_scalar(self, u_k: float, y_k: float) -> Trace:
+        """:meth:`keep_aside` of a sample of one input and one output (``step``'s fast path).
+
+        Only for a record that keeps samples aside (:attr:`plain_siso`: its channels known,
+        no decimation); ``u_k``, ``y_k`` real scalars (``float`` takes them).
+        """
+        u, y = float(u_k), float(y_k)
+        if u - u != 0.0 or y - y != 0.0:  # inf or nan (inf - inf is nan)
+            check_finite(np.array([[u]]), "u", self.n_seen)
+            check_finite(np.array([[y]]), "y", self.n_seen)
+        pending = self.buffer.pending  # type: ignore[union-attr]
+        pending.append(u)
+        pending.append(y)
+        self.n_seen = n = self.n_seen + 1
+        if n <= self.max_lag or (n - self.max_lag) % self.cluster:
+            empty = self.empty
+            return empty if empty is not None else self.empty_trace()
+        return self._take_aside()
+
+    def _take_aside(self) -> Trace:
+        """The samples kept aside into the buffer, and the one update they close.
+
+        :meth:`consume` of them, unrolled for the one update (``step``'s path): the
+        buffer's whole store goes to the kernel (no view made), then the rows no later
+        window needs are forgotten (:meth:`_forget`).
+        """
+        buf = self.buffer
+        assert buf is not None
+        store, first = buf.flushed()
+        j = self.j_done + 1
+        stepper = self.stepper or self._stepper()
+        trace = stepper.update(store, first - self.max_lag, j)
+        self.j_done = j
+        c = self.cluster
+        buf.drop_before(c * (j + 1) - self.settings.window_size - c)
+        return trace
 
     def consume(self, new: np.ndarray, mapper: Callable[..., Any] = map) -> Trace:
         """Append decimated samples and compute the updates they complete (a new trace).
@@ -256,13 +298,22 @@ class AppraiserState:
         buf = self.buffer
         assert buf is not None
         j = self.j_done + 1
-        samples = (buf.data, buf.start - self.max_lag)
-        setup = self.setup or self.kernel_setup()
-        arrays = kernel.update_one(setup, samples, j, self._fsm_state())
-        index = np.array([self.max_lag + self.cluster * j - 1])
-        trace = (self.labels or self.trace_labels()).trace(index, arrays.pop("n_rows"), arrays)
+        stepper = self.stepper or self._stepper()
+        trace = stepper.update(buf.data, buf.start - self.max_lag, j)
         self.j_done = j
         return trace
+
+    def _stepper(self) -> StepUpdates:
+        """``step``'s updates; the carried state and the cache become views of its state."""
+        stepper = StepUpdates(
+            self.kernel_setup(),
+            self._fsm_state(),
+            self.trace_labels(),
+            (self.max_lag, self.cluster),
+        )
+        (self.last_theta, self.last_c, self.has_model), self.blocks = stepper.state()
+        self.stepper = stepper
+        return stepper
 
     def _solve_into(self, part: Trace, mapper: Callable[..., Any]) -> None:
         """The next ``len(part)`` updates, written into ``part``'s arrays."""
