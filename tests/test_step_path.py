@@ -145,7 +145,11 @@ def test_a_lazy_row_reads_like_a_view_and_pickles_alone():
     assert "_view_of" in first.__dict__  # nothing sliced yet (len does not slice)
     assert len(first) == 1 and "_view_of" in first.__dict__
     assert first.theta.shape == (1, 6)  # (rows, p) as for any one-row trace
+    assert "_view_of" in first.__dict__  # a per-equation array is sliced alone
+    theta, d = first.theta.copy(), first.D.copy()
+    assert first.index.shape == (1,)  # any other field slices the whole row
     assert "_view_of" not in first.__dict__
+    assert np.array_equal(first.theta, theta) and np.array_equal(first.D, d)
     copied = copy.copy(last)
     assert np.array_equal(copied.D, last.D)
     replaced = dataclasses.replace(parts[1], meta={"x": 1})

@@ -86,7 +86,13 @@ class Trace:
         return int(self.arrays["theta"].shape[1])
 
     def __getattr__(self, name: str) -> np.ndarray:
-        if "_view_of" in self.__dict__:  # a view of lazy_view: its arrays made now
+        lazy = self.__dict__.get("_view_of")
+        if lazy is not None:  # a lazy_view: a per-equation array sliced alone, else all
+            block, start, stop = lazy
+            source = block.__dict__["arrays"].get(name)
+            if source is not None:
+                value = source[start:stop]
+                return value[:, 0] if value.shape[1] == 1 else value
             self._materialise()
             return getattr(self, name)
         arrays = self.__dict__.get("arrays")
@@ -192,8 +198,9 @@ class Trace:
 
         A view slices some 25 arrays (about 10 us); ``step`` returns its update as a view of
         a block of rows, and a caller that never reads it should not pay for the slicing.
-        The labels (``structure``, names, ``meta`` - a copy) are set at once; reading any
-        other attribute makes the view (:meth:`view`, the same arrays) and keeps it.
+        The labels (``structure``, names, ``meta`` - a copy) are set at once; a
+        per-equation array read by name (``theta``, ``D``, ...) is sliced alone, at each
+        read; any other field makes the view (:meth:`view`, the same arrays) and keeps it.
 
         Parameters
         ----------
