@@ -68,7 +68,11 @@ def sliding(rows, first, count, cluster):
 
 @numba.njit
 def tridiagonal(a, d, e):
-    """Householder reduction of symmetric ``a`` to (d, e); e[i] couples i - 1 and i."""
+    """Householder reduction of symmetric ``a`` to (d, e); e[i] couples i - 1 and i.
+
+    ``small_eigh._tred2``'s reduction without its accumulation of the transformation (the
+    kernel's solver needs the vectors, this floor does not).
+    """
     n = a.shape[0]
     v = a.copy()
     for j in range(n):
