@@ -165,24 +165,21 @@ class AppraiserState:
             self.record_dt = record_dt
 
     # ------------------------------------------------------------ the transition
-    def lag_rows(self, buf: np.ndarray) -> np.ndarray:
-        """Lag rows of every equation from decimated samples ``buf``: (E, n, p)."""
-        assert self.n_in is not None and self.n_out is not None
-        s = self.settings.structure
-        u, y = buf[:, : self.n_in], buf[:, self.n_in :]
-        if buf.shape[0] <= s.max_lag:
-            return np.empty((self.n_out, 0, self.n_params()))
-        miso = self.mode() == "miso"
-        return np.stack(
-            [miso_regressor(y[:, j], u if miso else u[:, j : j + 1], s) for j in range(self.n_out)]
-        )
-
     def window(self) -> np.ndarray:
         """The current window's lag vectors, shape (E, rows, p)."""
         if self.buffer is None:
             return np.empty((1, 0, self.settings.structure.n_params()))
+        assert self.n_in is not None and self.n_out is not None
+        s = self.settings.structure
         rows_total = max(self.n_seen - self.max_lag, 0)
-        return self.lag_rows(self.buffer.since(max(rows_total - self.settings.window_size, 0)))
+        buf = self.buffer.since(max(rows_total - self.settings.window_size, 0))
+        if buf.shape[0] <= s.max_lag:
+            return np.empty((self.n_out, 0, self.n_params()))
+        u, y = buf[:, : self.n_in], buf[:, self.n_in :]
+        miso = self.mode() == "miso"
+        return np.stack(
+            [miso_regressor(y[:, j], u if miso else u[:, j : j + 1], s) for j in range(self.n_out)]
+        )
 
     def updates_after(self, n_samples: int) -> int:
         """Updates that ``n_samples`` more (undecimated) samples will complete."""
@@ -225,21 +222,9 @@ class AppraiserState:
         return self._take_aside()
 
     def _take_aside(self) -> Trace:
-        """The samples kept aside into the buffer, and the one update they close.
-
-        :meth:`consume` of them, unrolled for the one update (``step``'s path): the
-        buffer's whole store goes to the kernel (no view made), then the rows no later
-        window needs are forgotten (:meth:`_forget`).
-        """
-        buf = self.buffer
-        assert buf is not None
-        store, first = buf.flushed()
-        j = self.j_done + 1
-        stepper = self.stepper or self._stepper()
-        trace = stepper.update(store, first - self.max_lag, j)
-        self.j_done = j
-        c = self.cluster
-        buf.drop_before(c * (j + 1) - self.settings.window_size - c)
+        """The samples kept aside into the buffer, and the one update they close (``step``)."""
+        trace = self._one_update()
+        self._forget()
         return trace
 
     def consume(self, new: np.ndarray, mapper: Callable[..., Any] = map) -> Trace:
@@ -294,12 +279,16 @@ class AppraiserState:
         return kernel.FsmState(self.last_theta, self.last_c, self.has_model), self.blocks
 
     def _one_update(self) -> Trace:
-        """The next update alone, as a new trace (the lean path of ``step``)."""
+        """The next update alone, as a new trace (``step``'s lean path, small pushes).
+
+        The samples kept aside join the buffer, whose whole store goes to the kernel (no
+        view made: :meth:`SampleBuffer.flushed`).
+        """
         buf = self.buffer
         assert buf is not None
+        store, first = buf.flushed()
         j = self.j_done + 1
-        stepper = self.stepper or self._stepper()
-        trace = stepper.update(buf.data, buf.start - self.max_lag, j)
+        trace = (self.stepper or self._stepper()).update(store, first - self.max_lag, j)
         self.j_done = j
         return trace
 
