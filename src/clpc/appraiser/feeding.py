@@ -16,7 +16,6 @@ import numpy as np
 
 from clpc.appraiser.decimation import Decimator
 from clpc.appraiser.inputs import (
-    SCALAR_TYPES,
     as_chunk,
     as_columns,
     as_record,
@@ -41,9 +40,10 @@ Progress = Callable[[int, int, int], Any]
 def feed_sample(state: AppraiserState, u_k: Any, y_k: Any, mapper: Mapper) -> Trace:
     """One sample (:meth:`clpc.CLPC.step`); the update it produced (0 or 1 rows).
 
-    Without decimation the sample is kept aside (plain floats; a scalar input and output
-    take :meth:`AppraiserState.keep_scalar`, which ``CLPC.step`` also calls directly) and
-    the update it closes is solved alone; else the sample is fed as a chunk of one.
+    Without decimation the sample is kept aside (plain floats) and the update it closes is
+    solved alone; else the sample is fed as a chunk of one. (A scalar input and output of a
+    single-channel record never come here: ``CLPC.step`` hands them to
+    :meth:`AppraiserState.keep_scalar`.)
 
     Parameters
     ----------
@@ -55,8 +55,6 @@ def feed_sample(state: AppraiserState, u_k: Any, y_k: Any, mapper: Mapper) -> Tr
         ``map`` of the batched solves.
     """
     s = state
-    if s.plain_siso and type(u_k) in SCALAR_TYPES and type(y_k) in SCALAR_TYPES:
-        return s.keep_scalar(u_k, y_k)  # plain floats, no arrays until the update
     rows_after = s.n_seen + 1 - s.max_lag
     update = rows_after > 0 and rows_after % s.cluster == 0
     u = as_columns(u_k, "u").ravel()

@@ -606,27 +606,6 @@ def outputs(count: int, setup: KernelSetup) -> Plain:
     return (*solved, np.empty(count, np.int64)), (*out, g[5], g[6], g[7], g[8], g[9])
 
 
-def solve(
-    samples: np.ndarray, first_row: int, windows: tuple[int, int], setup: KernelSetup
-) -> Solved:
-    """Solve windows ``windows = (j0, count)`` on their own, with no block cache.
-
-    For a piece of a long record solved on a worker (:mod:`clpc.distributed`): the block
-    statistics are computed from the samples, which gives the cached results bit for bit.
-    """
-    solved = Solved(*outputs(windows[1], setup)[0])
-    cache = new_cache(setup.plan.chan.shape, 0)
-    solve_windows(samples, first_row, windows, setup.plan, setup.settings, solved, cache)
-    return solved
-
-
-def output(solved: Solved, setup: KernelSetup, state: FsmState) -> FsmOutput:
-    """The FSM output of ``solved`` from ``state`` (updated in place), as ``update_windows``."""
-    out = FsmOutput(*outputs(solved.n_rows.shape[0], setup)[1])
-    fsm_output(solved, setup.fsm, state, out)
-    return out
-
-
 def batches(j_first: int, j_last: int, n_jobs: int) -> list[tuple[int, int]]:
     """``(j0, count)`` pairs covering updates ``j_first .. j_last`` (equal thread shares)."""
     n_new = j_last - j_first + 1
