@@ -6,7 +6,7 @@ explicit seed, so every statistical claim is checked on the same draws every tim
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -124,3 +124,29 @@ def make_model() -> Callable[..., LinearModel]:
         )
 
     return make
+
+
+@pytest.fixture
+def own_shm(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """The shared traces of this test in a folder of ``/dev/shm`` of its own.
+
+    Tests that check the shared trace's file is removed look at ``shared_rows.SHM``; with
+    ``-n 2`` another test may make its own files in ``/dev/shm`` at the same time. Without
+    ``/dev/shm`` nothing is changed (those tests skip).
+    """
+    import shutil
+    import uuid
+    from pathlib import Path
+
+    from clpc.distributed import shared_rows
+
+    if not shared_rows.SHM.is_dir():
+        yield
+        return
+    folder = Path(shared_rows.SHM) / f"clpc-test-{uuid.uuid4().hex}"
+    folder.mkdir()
+    monkeypatch.setattr(shared_rows, "SHM", folder)
+    try:
+        yield
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)

@@ -161,7 +161,9 @@ def _shm_files():
 
 
 @pytest.mark.parametrize("shm", [True, False])
-def test_run_long_is_clpc_run_with_or_without_shared_memory(client, monkeypatch, tmp_path, shm):
+def test_run_long_is_clpc_run_with_or_without_shared_memory(
+    client, monkeypatch, tmp_path, shm, own_shm
+):
     if shm and not shared_rows.SHM.is_dir():
         pytest.skip("no /dev/shm")
     if not shm:  # the client cannot make the file: every piece's rows are sent

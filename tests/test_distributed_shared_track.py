@@ -53,7 +53,7 @@ def _shm_files():
 
 @pytest.mark.parametrize("shm", [True, False])
 def test_track_long_settles_its_pieces_in_shared_memory_and_writes_the_same_dataset(
-    client, monkeypatch, tmp_path, shm
+    client, monkeypatch, tmp_path, shm, own_shm
 ):
     import pandas as pd
 
