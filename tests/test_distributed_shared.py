@@ -150,6 +150,28 @@ def test_a_process_that_does_not_see_the_file_sends_its_rows(tmp_path):
     made[0].remove()
 
 
+@needs_shm
+def test_a_claim_made_as_the_record_ends_does_not_outlive_it(monkeypatch):
+    # a late re-run of a piece opens the file just before the client removes it, then
+    # claims its rows: the claim is taken back, nothing is left in /dev/shm
+    n, settings = 6_011, {"window_size": 60, "cluster_size": 6}
+    plan, _ = _pieces(n, settings, 2_000)
+    like = plan.state().empty_trace()
+    made = SharedRows.create(like, 900, ((1,), (1,)))
+    assert made is not None
+    shared, real_open = made[0], os.open
+
+    def open_then_end(path, flags, *mode):
+        if flags & os.O_EXCL:  # the claim: the client ends the record just before it
+            shared.remove()
+        return real_open(path, flags, *mode)
+
+    monkeypatch.setattr(shared_rows.os, "open", open_then_end)
+    assert shared.open(like, (0, 100)) is None
+    monkeypatch.undo()
+    assert not list(shared_rows.SHM.glob(os.path.basename(shared.path) + "*"))
+
+
 @pytest.fixture(scope="module")
 def client():
     with dask_client(workers=2) as c:

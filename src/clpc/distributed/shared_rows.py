@@ -176,7 +176,7 @@ class SharedRows:
         except OSError:
             return None
         try:
-            if os.fstat(fd).st_size != self.size or not self._claimed(rows[0]):
+            if os.fstat(fd).st_size != self.size or not self._claimed(fd, rows[0]):
                 return None
             if not self._reserve(fd, rows):
                 return None
@@ -254,18 +254,26 @@ class SharedRows:
             return False
         return True
 
-    def _claimed(self, row: int) -> bool:
-        """Claim the rows that start at ``row`` (a file created exclusively); False: taken."""
+    def _claimed(self, fd: int, row: int) -> bool:
+        """Claim the rows that start at ``row`` (a file created exclusively); False: taken.
+
+        ``fd``: this process's descriptor of the file. A claim made after the file was
+        removed (a late re-run of a piece) is taken back: :meth:`remove` unlinks the file
+        before its claims, so no claim outlives the record.
+        """
+        name = f"{self.path}.rows-{row}"
         try:
-            claim = os.open(f"{self.path}.rows-{row}", os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-            os.close(claim)
+            os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
         except OSError:
+            return False
+        if os.fstat(fd).st_nlink == 0:  # the record is done: nothing to write into
+            Path(name).unlink(missing_ok=True)
             return False
         return True
 
     def remove(self) -> None:
         """Remove the file and its claims (the maps stay valid until their arrays are let go)."""
         path = Path(self.path)
+        path.unlink(missing_ok=True)  # first: a claim made from now on is taken back
         for claim in path.parent.glob(f"{path.name}.rows-*"):
             claim.unlink(missing_ok=True)
-        path.unlink(missing_ok=True)
