@@ -56,6 +56,11 @@ def _bad_inputs(u):
         "words": (np.array(["a"] * len(u)), "the text 'a'"),
         "huge int": (np.array([10**400] + [1] * (len(u) - 1), dtype=object), "too large"),
         "1e80": (u * 1e80, "cannot be solved in double precision"),
+        "one -1e80": (np.where(np.arange(len(u)) == 4, -1e80, u), "reaches 1e\\+80"),
+        "1e80 beside a NaN": (
+            np.where(np.arange(len(u)) == 2, np.nan, np.where(np.arange(len(u)) == 6, 1e80, u)),
+            "reaches 1e\\+80",
+        ),
         "dict objects": (np.array([{}] * len(u), dtype=object), "must hold numbers"),
     }
 

@@ -22,7 +22,7 @@ from clpc.appraiser.inputs import (
     check_chunk,
     check_finite,
 )
-from clpc.appraiser.spread import attach_levels
+from clpc.appraiser.levels import attach_levels
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
 from clpc.data.samples import check_spread

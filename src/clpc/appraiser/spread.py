@@ -10,14 +10,11 @@ disagreement from the trace alone; the operating points themselves need the data
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 __all__ = [
     "GAIN_SPREAD_LIMIT",
     "TREND_LIMIT",
-    "attach_levels",
     "gain_spread",
     "level_trend",
     "window_dc_gains",
@@ -33,25 +30,6 @@ GAIN_SPREAD_LIMIT = 0.35
 #: which the disagreement follows the operating point (crank servo 0.93-0.94, its control
 #: 0.72-0.82; those linear records 0.52-0.53)
 TREND_LIMIT = 0.6
-
-
-def attach_levels(trace: Any, y: np.ndarray, factor: int) -> None:
-    """Store each window's mean output in ``trace.meta["window_level"]`` (n_updates, n_out).
-
-    ``y`` (shape (T, n_out)) is the record given to :meth:`clpc.CLPC.run` at the data's
-    rate; decimated sample ``k`` is record sample ``k * factor``, so a window of ``rows``
-    lag vectors ending at ``k`` spans record samples ``(k - rows + 1) f .. k f``.
-    """
-    if len(trace) == 0:
-        return
-    yy = np.asarray(y, dtype=np.float64)
-    last = np.minimum(np.asarray(trace.index, dtype=np.int64) * factor, yy.shape[0] - 1)
-    first = np.maximum((np.asarray(trace.index) - np.asarray(trace.rows) + 1) * factor, 0)
-    first = np.minimum(first, last)
-    ref = yy.mean(axis=0)
-    csum = np.vstack([np.zeros((1, yy.shape[1])), np.cumsum(yy - ref, axis=0)])
-    count = (last - first + 1)[:, None]
-    trace.meta["window_level"] = (csum[last + 1] - csum[first]) / count + ref
 
 
 def level_trend(levels: np.ndarray, gains: np.ndarray) -> float:

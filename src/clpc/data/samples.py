@@ -205,8 +205,12 @@ def check_magnitude(arr: np.ndarray, name: str) -> None:
     """Refuse finite values above :data:`MAX_MAGNITUDE` (a :class:`DataError`)."""
     if arr.size == 0:
         return
-    with np.errstate(invalid="ignore"):
-        peak = np.nanmax(np.where(np.isfinite(arr), np.abs(arr), 0.0))
+    hi, lo = float(arr.max()), float(arr.min())  # two passes, no temporary of arr's size
+    if math.isfinite(hi) and math.isfinite(lo):
+        peak = max(hi, -lo)
+    else:  # a NaN or an infinity (refused later, with its index): the largest finite value
+        with np.errstate(invalid="ignore"):
+            peak = np.nanmax(np.where(np.isfinite(arr), np.abs(arr), 0.0))
     if peak > MAX_MAGNITUDE:
         raise DataError(
             f"{name} reaches {peak:.3g}: beyond {MAX_MAGNITUDE:.0e} this cannot be solved in "

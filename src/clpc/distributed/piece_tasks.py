@@ -35,6 +35,7 @@ import numpy as np
 from clpc.appraiser import kernel
 from clpc.appraiser.decimation import Decimator
 from clpc.appraiser.inputs import as_chunk
+from clpc.appraiser.levels import window_means
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
@@ -155,22 +156,16 @@ def _kept(raw: np.ndarray, layout: Layout, piece: Piece) -> np.ndarray:
 
 
 def _levels(y: np.ndarray, plan: RecordPlan, piece: Piece, rows: np.ndarray) -> np.ndarray:
-    """Each window's mean output, as :func:`clpc.appraiser.spread.attach_levels` defines it.
+    """Each window's mean output, as :func:`clpc.appraiser.levels.attach_levels` defines it.
 
-    Summed within the piece (its own reference level), so the values agree with the
+    Summed within the piece (about its own mean), so the values agree with the
     single-process ones to rounding, not bit for bit.
     """
     lay, lo = plan.layout, piece.raw[0]
     index = lay.max_lag + lay.cluster * np.arange(piece.j_lo, piece.j_hi + 1) - 1
     last = np.minimum(index * lay.factor, plan.n_raw - 1)
     first = np.minimum(np.maximum((index - rows + 1) * lay.factor, 0), last)
-    out = np.empty((index.size, y.shape[1]))
-    for k in range(y.shape[1]):  # column by column: contiguous sums
-        col = np.ascontiguousarray(y[:, k])
-        ref = col.mean()
-        csum = np.concatenate([[0.0], np.cumsum(col - ref)])
-        out[:, k] = (csum[last - lo + 1] - csum[first - lo]) / (last - first + 1) + ref
-    return out
+    return window_means(y, first - lo, last - lo)
 
 
 def _peaks(columns: list[np.ndarray]) -> np.ndarray:
