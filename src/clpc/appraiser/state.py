@@ -2,7 +2,9 @@
 
 :class:`AppraiserState` holds the FSM state - the samples the next windows need, the counters, the
 last parameters, the decimation filter - and the transition (:meth:`AppraiserState.consume`:
-new samples in, the updates they complete out). Its saved form is
+new samples in, the updates they complete out). What the record's channels fix (the MIMO
+mode, the parameters, the kernel setup, the trace labels) comes from its base class
+:class:`~clpc.appraiser.record_layout.RecordLayout`. Its saved form is
 :mod:`clpc.appraiser.saved_state` (:meth:`AppraiserState.resume` continues from it).
 """
 
@@ -18,33 +20,27 @@ from clpc.appraiser import kernel
 from clpc.appraiser.buffer import SampleBuffer
 from clpc.appraiser.decimation import Decimator
 from clpc.appraiser.inputs import check_finite
-from clpc.appraiser.settings import Settings
+from clpc.appraiser.record_layout import RecordLayout
 from clpc.appraiser.state_schema import FORMAT, VERSION, digest
 from clpc.appraiser.step_block import StepUpdates
 from clpc.appraiser.trace import Trace
-from clpc.appraiser.trace_labels import TraceLabels
 from clpc.data import DataError
 from clpc.lpc.regressors import miso_regressor
-from clpc.model.structure import check_mode, default_mode
 
 __all__ = ["FORMAT", "VERSION", "AppraiserState", "digest"]
 
 
 @dataclass(eq=False, slots=True)
-class AppraiserState:
+class AppraiserState(RecordLayout):
     """The FSM state of one record; a new one per record (:meth:`clpc.CLPC.reset`).
 
     ``n_seen`` counts decimated samples (those kept aside included), ``j_done`` updates;
     ``last_theta``, ``last_c``, ``has_model`` are the carried output (:class:`kernel.FsmState`).
-    ``setup``, ``labels`` and ``empty`` are fixed per record once the channels are known.
+    The channels, names, ``setup``, ``labels`` and ``empty`` are :class:`RecordLayout`'s.
     """
 
-    settings: Settings
     max_lag: int = 0
     cluster: int = 1
-    n_in: int | None = None
-    n_out: int | None = None
-    names: tuple[tuple[str, ...], tuple[str, ...]] | None = None
     buffer: SampleBuffer | None = None
     n_seen: int = 0
     j_done: int = 0
@@ -52,12 +48,8 @@ class AppraiserState:
     last_c: np.ndarray | None = None
     has_model: np.ndarray | None = None
     decimator: Decimator | None = None
-    record_dt: float | None = None
     plain: bool = False  #: no decimation: step keeps samples aside
     plain_siso: bool = False  #: and one input, one output: step's fastest path
-    setup: kernel.KernelSetup | None = None
-    labels: TraceLabels | None = None
-    empty: Trace | None = None
     blocks: kernel.BlockCache | None = None  #: statistics of the newest blocks (derived)
     stepper: StepUpdates | None = None  #: step's updates (made on the first; derived)
 
@@ -65,33 +57,7 @@ class AppraiserState:
         self.max_lag = self.settings.structure.max_lag
         self.cluster = self.settings.cluster_size
 
-    # ------------------------------------------------------------ the record's layout
-    def mode(self) -> str:
-        """The MIMO mode in use (validated against the channel counts)."""
-        assert self.n_in is not None and self.n_out is not None
-        chosen = self.settings.mimo or default_mode(self.n_in, self.n_out)
-        check_mode(chosen, self.n_in, self.n_out)
-        return str(chosen)
-
-    def n_blocks(self) -> int:
-        """Input blocks of a lag vector (all inputs with ``miso``, else one)."""
-        assert self.n_in is not None
-        return self.n_in if self.mode() == "miso" else 1
-
-    def n_params(self) -> int:
-        """Parameters of one equation."""
-        return self.settings.structure.n_params(self.n_blocks())
-
-    def min_rows(self) -> int:
-        """Fewest rows of a usable window (default ``2 p``)."""
-        given = self.settings.min_rows
-        return given if given is not None else 2 * self.n_params()
-
-    def time_step(self) -> float:
-        """Seconds per (decimated) sample: ``decimate_to``, else the data's, else 1."""
-        s = self.settings
-        return s.decimate_to or self.record_dt or s.dt or 1.0
-
+    # ------------------------------------------------------------ the record's channels
     def set_decimator(self, decimator: Decimator) -> None:
         """Use ``decimator`` for the samples fed from now on."""
         self.decimator = decimator
@@ -117,27 +83,6 @@ class AppraiserState:
                 f"the appraiser was fed {self.n_in} input(s) and {self.n_out} output(s); "
                 f"this chunk has {n_in} and {n_out}. Call reset() to start a new record."
             )
-
-    def kernel_setup(self) -> kernel.KernelSetup:
-        """The kernel's plan and settings (fixed per record)."""
-        if self.setup is None:
-            assert self.n_in is not None and self.n_out is not None
-            channels = (self.n_in, self.n_out, self.mode() == "miso")
-            self.setup = kernel.record_setup(
-                self.settings, channels, self.n_params(), self.min_rows()
-            )
-        return self.setup
-
-    def trace_labels(self) -> TraceLabels:
-        """What the traces of this record say besides the numbers."""
-        if self.labels is not None:
-            return self.labels
-        channels = (self.n_in or 1, self.n_out or 1)
-        mode = self.mode() if self.n_in is not None else "siso"
-        labels = TraceLabels.of_record(self.settings, channels, self.names, mode, self.time_step())
-        if self.n_in is not None:
-            self.labels = labels
-        return labels
 
     def resume(
         self,
@@ -326,13 +271,3 @@ class AppraiserState:
         assert self.buffer is not None
         c = self.cluster
         self.buffer.drop_before(max(0, c * (self.j_done + 1) - self.settings.window_size - c))
-
-    def empty_trace(self) -> Trace:
-        """A trace without updates, shaped for the record's channels (cached once known)."""
-        if self.empty is not None:
-            return self.empty
-        p = self.n_params() if self.n_in is not None else self.settings.structure.n_params()
-        empty = self.trace_labels().empty(self.n_out or 1, p)
-        if self.n_in is not None:
-            self.empty = empty
-        return empty
