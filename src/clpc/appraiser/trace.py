@@ -1,7 +1,9 @@
 """The output of the appraiser: one row per cluster update, plus the convergence verdict.
 
 Array keys and table layout: :mod:`clpc.appraiser.trace_table`; how the traces of one record
-are made: :class:`~clpc.appraiser.trace_labels.TraceLabels`.
+are made: :class:`~clpc.appraiser.trace_labels.TraceLabels`; what a trace concludes (``held``,
+``convergence``, ``steady_state_model``): its base class
+:class:`~clpc.appraiser.trace_verdict.TraceVerdict`.
 """
 
 from __future__ import annotations
@@ -13,12 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from clpc.appraiser import convergence
 from clpc.appraiser.convergence import MIN_TRUSTED_FRACTION, Convergence
-from clpc.appraiser.convergence import steady_state_model as steady_state
 from clpc.appraiser.trace_table import PER_EQUATION, SCALAR_KEYS, theta_labels, trace_frame
+from clpc.appraiser.trace_verdict import TraceVerdict
 from clpc.core.compact import compact_repr
-from clpc.model import LinearModel
 from clpc.model.structure import Structure
 
 __all__ = ["MIN_TRUSTED_FRACTION", "PER_EQUATION", "SCALAR_KEYS", "Convergence", "Trace"]
@@ -26,7 +26,7 @@ __all__ = ["MIN_TRUSTED_FRACTION", "PER_EQUATION", "SCALAR_KEYS", "Convergence",
 
 @compact_repr
 @dataclass(frozen=True, eq=False)
-class Trace:
+class Trace(TraceVerdict):
     """Per-update record of a CLPC run (one row per cluster update).
 
     Arrays of every equation carry an equation axis 1; the properties of the same name
@@ -282,67 +282,6 @@ class Trace:
             meta["window_level"] = np.asarray(levels)[rows]
         kw: dict[str, Any] = {f: getattr(self, f)[rows] for f in _ROW_FIELDS}
         return replace(self, **kw, arrays={k: v[rows] for k, v in self.arrays.items()}, meta=meta)
-
-    def held(self, n_samples: int) -> np.ndarray:
-        """Held output parameters at every sample ``k = 0 .. n_samples - 1``.
-
-        Parameters
-        ----------
-        n_samples : int
-            Samples of the (decimated) record.
-
-        Returns
-        -------
-        ndarray, shape (n_samples, n_equations, p)
-            Zeros before the first update (no model yet).
-        """
-        k = np.arange(n_samples)
-        last = np.searchsorted(self.index, k, side="right") - 1
-        theta = self.arrays["theta"]
-        out = np.zeros((n_samples, *theta.shape[1:]))
-        ok = last >= 0
-        out[ok] = theta[last[ok]]
-        return out
-
-    # ----------------------------------------------------------------- verdict
-    def convergence(
-        self, theta_tol: float = 0.02, D_tol: float = 0.1, consecutive: int = 5
-    ) -> Convergence:
-        """First update after which ``theta`` and ``D`` stay quasi-constant.
-
-        ``consecutive`` updates in a row within the tolerances below, and at least
-        :data:`MIN_TRUSTED_FRACTION` of the windows trusted
-        (:func:`clpc.appraiser.convergence.convergence`).
-
-        Parameters
-        ----------
-        theta_tol : float
-            Largest move of ``theta`` between updates (Euclidean, unit vectors).
-        D_tol : float
-            Largest relative move of ``D`` between updates.
-        consecutive : int
-            Quasi-constant updates in a row that make convergence.
-        """
-        return convergence.convergence(self, theta_tol, D_tol, consecutive)
-
-    def steady_state_model(
-        self, convergence: Convergence | None = None, *, allow_unconverged: bool = False
-    ) -> LinearModel:
-        """The identified black box: the mean accepted ``theta`` of the quasi-constant phase.
-
-        Parameters
-        ----------
-        convergence : Convergence, optional
-            Default: :meth:`convergence` with its default tolerances.
-        allow_unconverged : bool
-            If the trace never converged, use the last accepted update instead of raising.
-
-        Returns
-        -------
-        LinearModel
-            With ``info["convergence"]``.
-        """
-        return steady_state(self, convergence, allow_unconverged=allow_unconverged)
 
 
 _FIELD_NAMES = {f.name for f in fields(Trace)}
