@@ -191,7 +191,7 @@ def test_a_save_that_fails_midway_leaves_the_previous_state_whole(tmp_path, monk
         fh.write('{"format": "clpc')  # part of the file, then the process dies
         raise KeyboardInterrupt
 
-    monkeypatch.setattr("clpc.appraiser.saved_state.json.dump", broken)
+    monkeypatch.setattr("clpc.appraiser.state_file.json.dump", broken)
     with pytest.raises(KeyboardInterrupt):
         appraiser.save(str(path))
     assert path.read_bytes() == good

@@ -3,8 +3,9 @@
 Semantics (lag vectors, growing then sliding windows, accept-or-hold, guard, decimation):
 ``docs/clpc.md``. Settings: :class:`clpc.appraiser.settings.Settings` (read-only). The FSM
 state: :class:`clpc.appraiser.state.AppraiserState`, one per record, fed by
-:mod:`clpc.appraiser.feeding`, saved by :mod:`clpc.appraiser.saved_state`; records not in
-memory go to the runners of :mod:`clpc.appraiser.runners`.
+:mod:`clpc.appraiser.feeding`, saved by :mod:`clpc.appraiser.saved_state` (its file:
+:mod:`clpc.appraiser.state_file`, ``save`` and ``load``); records not in memory go to the
+runners of :mod:`clpc.appraiser.runners`.
 """
 
 from __future__ import annotations
@@ -18,16 +19,17 @@ import numpy as np
 from clpc.appraiser.feeding import feed_chunk, feed_record, feed_sample
 from clpc.appraiser.inputs import SCALAR_TYPES, as_chunk
 from clpc.appraiser.runners import register_runner, runner_for
-from clpc.appraiser.saved_state import read_state, restored, saved_form, write_state
+from clpc.appraiser.saved_state import restored, saved_form
 from clpc.appraiser.settings import Settings, SettingsProperties
 from clpc.appraiser.state import AppraiserState
+from clpc.appraiser.state_file import StateFile
 from clpc.appraiser.trace import Trace
 from clpc.core.rules import RobustRule
 
 __all__ = ["CLPC", "register_runner"]
 
 
-class CLPC(SettingsProperties):
+class CLPC(SettingsProperties, StateFile):
     """The Cluster LPC appraiser: streaming ``step``/``push`` and a vectorised ``run``.
 
     Every setting is named (keyword-only); ``docs/clpc.md`` maps the paper's names to them.
@@ -259,40 +261,6 @@ class CLPC(SettingsProperties):
         appraiser._start(fsm.settings)
         appraiser._state = fsm
         return appraiser
-
-    def save(self, path: str) -> None:
-        """Write :meth:`state_dict` as JSON to ``path``, atomically.
-
-        The state is written to a temporary file beside ``path`` and renamed over it, so a
-        run killed while saving leaves the previous state file whole.
-
-        Parameters
-        ----------
-        path : str
-            Destination file (replaced if it exists).
-
-        Raises
-        ------
-        clpc.core.atomic.OutputError
-            ``path`` is a symbolic link, or writing failed (``path`` is left as it was).
-        """
-        write_state(path, self.state_dict())
-
-    @classmethod
-    def load(cls, path: str) -> CLPC:
-        """Read an appraiser saved with :meth:`save`.
-
-        Parameters
-        ----------
-        path : str
-            A file written by :meth:`save`.
-
-        Returns
-        -------
-        CLPC
-            The appraiser, continuing where the saved one stopped.
-        """
-        return cls.from_state_dict(read_state(path))
 
     def __repr__(self) -> str:
         return (

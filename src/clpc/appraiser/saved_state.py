@@ -3,13 +3,11 @@
 :func:`saved_form` is what :meth:`clpc.CLPC.state_dict` returns - format, version, the
 settings, the FSM state of an :class:`~clpc.appraiser.state.AppraiserState` (floats
 round-trip exactly) and a digest; :func:`restored` reads it back, every field checked
-(:mod:`clpc.appraiser.state_schema`); :func:`write_state` / :func:`read_state` are its JSON
-file (written atomically, read with a size bound).
+(:mod:`clpc.appraiser.state_schema`). Its JSON file: :mod:`clpc.appraiser.state_file`.
 """
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import numpy as np
@@ -19,7 +17,6 @@ from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.state_schema import (
     FORMAT,
-    MAX_STATE_BYTES,
     VERSION,
     StateError,
     check_digest,
@@ -30,14 +27,12 @@ from clpc.appraiser.state_schema import (
     checked_names,
     digest,
     field,
-    parse_json,
     reading_state,
     validate_counters,
 )
-from clpc.core.atomic import atomic_file
 from clpc.core.checks import check_positive
 
-__all__ = ["read_state", "restored", "saved_form", "write_state"]
+__all__ = ["restored", "saved_form"]
 
 
 def saved_form(config: dict[str, Any], state: AppraiserState) -> dict[str, Any]:
@@ -75,33 +70,6 @@ def restored(saved: dict[str, Any]) -> AppraiserState:
         state = _from_fields(settings, saved)
         check_digest(saved)
     return state
-
-
-def write_state(path: str, saved: dict[str, Any]) -> None:
-    """Write a saved state as JSON to ``path``, atomically (:func:`clpc.core.atomic.atomic_file`).
-
-    Parameters
-    ----------
-    path : str
-        Destination file (replaced if it exists; left as it was if writing fails).
-    saved : dict
-        What :func:`saved_form` returned.
-    """
-    with atomic_file(path) as fh:
-        json.dump(saved, fh)
-
-
-def read_state(path: str) -> dict[str, Any]:
-    """The saved state in the JSON file ``path`` (at most ``MAX_STATE_BYTES`` are read).
-
-    Parameters
-    ----------
-    path : str
-        A file written by :func:`write_state`.
-    """
-    with open(path, encoding="utf-8") as fh:
-        text = fh.read(MAX_STATE_BYTES + 1)
-    return parse_json(text)
 
 
 def _fields(state: AppraiserState) -> dict[str, Any]:
