@@ -64,7 +64,9 @@ class CLPC(SettingsProperties, StateFile):
     n_jobs : int
         Threads for the batched solves (windows are independent).
     chunk_samples : int
-        Samples processed at a time by :meth:`push` (bounds memory).
+        Samples processed at a time by :meth:`run` and :meth:`push`: bounds their working
+        memory (a few copies of a chunk, 8 bytes per sample and channel); larger chunks
+        mean fewer hand-overs between the ``n_jobs`` threads.
 
     Notes
     -----
@@ -94,7 +96,7 @@ class CLPC(SettingsProperties, StateFile):
         trust_rows: int | None = None,
         min_rows: int | None = None,
         n_jobs: int = 1,
-        chunk_samples: int = 65536,
+        chunk_samples: int = 524288,
     ) -> None:
         settings = Settings(
             order, window_size, cluster_size, dt, decimate_to, guard, na, nb, nk, method,

@@ -51,7 +51,7 @@ class Settings:
     trust_rows: int | None = None
     min_rows: int | None = None
     n_jobs: int = 1
-    chunk_samples: int = 65536
+    chunk_samples: int = 524288
     structure: Structure = dc_field(init=False)
 
     def __post_init__(self) -> None:
