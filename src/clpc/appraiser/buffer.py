@@ -80,8 +80,12 @@ class SampleBuffer:
         """Room for ``n`` more rows after the live ones (moved to the front if needed)."""
         if self._hi + n > self._store.shape[0]:
             live = self._hi - self._lo
-            store = np.empty((2 * (live + n), self._store.shape[1]))
-            store[:live] = self._store[self._lo : self._hi]
+            if live + n <= self._store.shape[0]:  # room at the front: the live rows move there
+                store = self._store
+                store[:live] = store[self._lo : self._hi].copy()  # (they may overlap)
+            else:
+                store = np.empty((2 * (live + n), self._store.shape[1]))
+                store[:live] = self._store[self._lo : self._hi]
             self._use(store, 0, live)
 
     def drop_before(self, sample: int) -> None:

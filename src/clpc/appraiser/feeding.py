@@ -99,16 +99,20 @@ def feed_chunk(
     # the kernel writes the updates straight into the final arrays (no copies)
     out = Trace.allocate(s.empty_trace(), total) if total else s.empty_trace()
     done, step = 0, s.settings.chunk_samples
+    n_in = u2.shape[1]
+    rows = np.empty((min(step, n), n_in + y2.shape[1]))  # one chunk's [u | y], reused
     for lo in range(0, n, step):  # bounded working memory
-        hi = lo + step
-        block = decimator(np.hstack([u2[lo:hi], y2[lo:hi]]))
+        hi = min(lo + step, n)
+        rows[: hi - lo, :n_in] = u2[lo:hi]
+        rows[: hi - lo, n_in:] = y2[lo:hi]
+        block = decimator(rows[: hi - lo])  # the buffer copies what it keeps
         if total:
             done = s.consume_into(block, mapper, out, done)
         else:
             s.consume(block, mapper)  # no update: the samples are only kept
-        _LOG.debug("CLPC: %d of %d samples, %d updates", min(hi, n), n, done)
+        _LOG.debug("CLPC: %d of %d samples, %d updates", hi, n, done)
         if progress is not None:
-            progress(min(hi, n), n, done)
+            progress(hi, n, done)
     assert done == total, (done, total)
     return out
 
