@@ -43,7 +43,9 @@ bytes per piece sent between
 workers (the workers' ``transfer_incoming_log``, Dask's size estimates) and to this process
 (Dask's sizes of the finishes' results: with ``run_long`` on one machine only the windows'
 levels, the rows being in the shared trace); peak RSS of each worker and of this process (added by
-the run). The load average is printed before and after: the machine may be shared.
+the run). The load average is printed before and after: the machine may be shared. The
+median runs of each side are compared too: on a virtual machine whose own speed moves by a
+third from minute to minute, the best of a few runs can be one lucky minute.
 
 Usage::
 
@@ -59,6 +61,7 @@ import itertools
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -415,6 +418,18 @@ def main() -> None:
             print("best of each:")
             for mode in MODES:
                 _show(min((r for r in runs if r["mode"] == mode), key=lambda r: r["wall"]), n, ref)
+            # the machine's own speed moves between runs (by a third on the VM this was
+            # written on): the medians, each side's runs interleaved, say it more steadily
+            mid = {
+                "wall": statistics.median(r["wall"] for r in singles),
+                "track": {"wall": statistics.median(r["wall"] for r in tracks)},
+                "long": {"wall": statistics.median(r["wall"] for r in longs)},
+            }
+            print(f"median of each (references: CLPC.run {mid['wall']:.2f} s):")
+            for mode in MODES:
+                wall = statistics.median(r["wall"] for r in runs if r["mode"] == mode)
+                ratios = _ratios({"mode": mode, "wall": wall}, mid)
+                print(f"  {mode:10s} wall {wall:5.2f} s  {ratios}")
     print(f"\nload average after: {os.getloadavg()}")
 
 
