@@ -32,6 +32,7 @@ from numba.extending import get_cython_function_address
 sys.path.insert(0, str(Path(__file__).parent))
 from clpc_table import WINDOW, record
 
+from clpc.appraiser import blocks
 from clpc.appraiser import kernel as K
 from clpc.core.rules import is_excited
 from clpc.core.small_eigh import sym_eig
@@ -60,8 +61,8 @@ def stages(samples, first_row, windows, plan, s, upto):
     acc = 0.0
     for b in range(n_blocks):
         lo = (b_lo + b) * size
-        K.piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
-        b_step[b] = K.piece_step(samples, chan[0], first, (lo, lo + size))
+        blocks.piece_stats(samples, chan, lag, first, (lo, lo + size), z, (b_mean[b], b_scat[b]))
+        b_step[b] = blocks.piece_step(samples, chan[0], first, (lo, lo + size))
     if upto < 2:
         return acc
     for w in range(count):
@@ -73,17 +74,17 @@ def stages(samples, first_row, windows, plan, s, upto):
         h_start = min(max(full_hi * size, t_end), e)
         t_size, h_size = t_end - start, e - h_start
         if t_size > 0:
-            K.piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
+            blocks.piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
         if h_size > 0:
-            K.piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
-        step = K.piece_step(samples, chan[0], first, (start, t_end))
-        step = min(step, K.piece_step(samples, chan[0], first, (h_start, e)))
+            blocks.piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
+        step = blocks.piece_step(samples, chan[0], first, (start, t_end))
+        step = min(step, blocks.piece_step(samples, chan[0], first, (h_start, e)))
         for b in range(full_lo - b_lo, full_hi - b_lo):
             step = min(step, b_step[b])
         acc += t_mean[0] + step
         if upto < 3:
             continue
-        n_w = K.merge(
+        n_w = blocks.merge(
             (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
             (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
             dev,
