@@ -150,3 +150,24 @@ def own_shm(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
         yield
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def client() -> Iterator[object]:
+    """A local Dask cluster of two worker processes, one per test module that asks for it."""
+    from clpc.distributed import dask_client
+
+    with dask_client(workers=2) as c:
+        yield c
+
+
+@pytest.fixture
+def shm_files() -> object:
+    """A function listing the shared traces in ``shared_rows.SHM`` (empty without it)."""
+    from clpc.distributed import shared_rows
+
+    def listed() -> set[object]:
+        shm = shared_rows.SHM
+        return set(shm.glob("clpc-trace-*")) if shm.is_dir() else set()
+
+    return listed

@@ -18,14 +18,8 @@ da = pytest.importorskip("dask.array")
 
 from clpc import CLPC, DataError  # noqa: E402
 from clpc.appraiser.decimation import decimate  # noqa: E402
-from clpc.distributed import dask_client, open_source, run_long  # noqa: E402
+from clpc.distributed import open_source, run_long  # noqa: E402
 from clpc.distributed.pieces import Layout, warmup  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(workers=2) as c:
-        yield c
 
 
 def _record(n: int, seed: int = 3, quiet: tuple[int, int] | None = None):

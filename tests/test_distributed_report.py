@@ -15,15 +15,8 @@ from scipy import signal
 pytest.importorskip("distributed")
 
 import clpc.workflows as wf
-from clpc.distributed import dask_client
 from clpc.distributed.track_command import track_settings
 from clpc.report.drawing import Drawing
-
-
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(workers=2) as c:
-        yield c
 
 
 def _settings(path, out, **kw):

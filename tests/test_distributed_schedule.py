@@ -15,7 +15,7 @@ pytest.importorskip("distributed")
 msgpack = pytest.importorskip("msgpack")
 
 from clpc import CLPC  # noqa: E402
-from clpc.distributed import dask_client, run_long, schedule  # noqa: E402
+from clpc.distributed import run_long, schedule  # noqa: E402
 from clpc.distributed.piece_tasks import PieceInfo  # noqa: E402
 
 
@@ -43,12 +43,6 @@ def test_a_pieces_numbers_cross_an_event_exactly():
     for have, want in [*pairs, *zip(back.end, info.end, strict=True)]:
         assert have.dtype == want.dtype and have.shape == want.shape
         assert have.tobytes() == want.tobytes()  # bit for bit (-0.0 and subnormals too)
-
-
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(workers=2) as c:
-        yield c
 
 
 @pytest.mark.parametrize("events", [True, False])

@@ -16,7 +16,7 @@ from scipy import signal
 pytest.importorskip("distributed")
 
 from clpc import CLPC
-from clpc.distributed import dask_client, run_long, shared_rows
+from clpc.distributed import run_long, shared_rows
 from clpc.distributed.long_record import plan_record
 from clpc.distributed.piece_tasks import (
     finish_piece,
@@ -172,19 +172,9 @@ def test_a_claim_made_as_the_record_ends_does_not_outlive_it(monkeypatch):
     assert not list(shared_rows.SHM.glob(os.path.basename(shared.path) + "*"))
 
 
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(workers=2) as c:
-        yield c
-
-
-def _shm_files():
-    return set(shared_rows.SHM.glob("clpc-trace-*")) if shared_rows.SHM.is_dir() else set()
-
-
 @pytest.mark.parametrize("shm", [True, False])
 def test_run_long_is_clpc_run_with_or_without_shared_memory(
-    client, monkeypatch, tmp_path, shm, own_shm
+    client, monkeypatch, tmp_path, shm, own_shm, shm_files
 ):
     if shm and not shared_rows.SHM.is_dir():
         pytest.skip("no /dev/shm")
@@ -194,13 +184,13 @@ def test_run_long_is_clpc_run_with_or_without_shared_memory(
 
     u, y = _record(40_009)
     ref = CLPC().run(u, y)
-    before = _shm_files()
+    before = shm_files()
     got = run_long(CLPC(), da.from_array(u, chunks=7_000), da.from_array(y, chunks=9_000),
                    client=client, piece_samples=6_000)  # fmt: skip
     _assert_equal(ref, got)
     levels = (got.meta["window_level"], ref.meta["window_level"])
     np.testing.assert_allclose(*levels, rtol=1e-12, atol=1e-13)  # as test_distributed_long
-    assert _shm_files() == before  # the file is removed when the record is done
+    assert shm_files() == before  # the file is removed when the record is done
 
 
 @needs_shm

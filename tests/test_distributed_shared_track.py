@@ -21,7 +21,7 @@ from scipy import signal
 pytest.importorskip("distributed")
 
 from clpc import CLPC
-from clpc.distributed import dask_client, open_source, shared_rows, track_long
+from clpc.distributed import open_source, shared_rows, track_long
 from clpc.distributed.long_record import plan_record
 from clpc.distributed.long_track import SUMMARY_KEYS
 from clpc.distributed.part_file import write_piece
@@ -41,19 +41,9 @@ def _record(n: int, seed: int = 11):
     return u, y
 
 
-@pytest.fixture(scope="module")
-def client():
-    with dask_client(workers=2) as c:
-        yield c
-
-
-def _shm_files():
-    return set(shared_rows.SHM.glob("clpc-trace-*")) if shared_rows.SHM.is_dir() else set()
-
-
 @pytest.mark.parametrize("shm", [True, False])
 def test_track_long_settles_its_pieces_in_shared_memory_and_writes_the_same_dataset(
-    client, monkeypatch, tmp_path, shm, own_shm
+    client, monkeypatch, tmp_path, shm, own_shm, shm_files
 ):
     import pandas as pd
 
@@ -68,14 +58,14 @@ def test_track_long_settles_its_pieces_in_shared_memory_and_writes_the_same_data
     np.save(tmp_path / "rec.npy", np.column_stack([u, y]))
     settings = {"window_size": 90, "cluster_size": 10}
     ref = CLPC(**settings).run(u, y)
-    before = _shm_files()
+    before = shm_files()
     source = open_source(tmp_path / "rec.npy", (0,), (1,))
     done = track_long(CLPC(**settings), source, tmp_path / "out", client=client,
                       piece_samples=2_000)  # fmt: skip
     done.close()
     assert done.parts > 10
     assert done.in_place == (done.parts if shm else 0)
-    assert _shm_files() == before  # the file is removed
+    assert shm_files() == before  # the file is removed
     table = pd.read_parquet(tmp_path / "out" / "trace").sort_values("index")
     named = dataclasses.replace(ref, input_names=("col0",), output_names=("col1",))
     names, want = trace_columns(named)
