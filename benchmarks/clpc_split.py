@@ -32,7 +32,7 @@ from numba.extending import get_cython_function_address
 sys.path.insert(0, str(Path(__file__).parent))
 from clpc_table import WINDOW, record
 
-from clpc.appraiser import blocks
+from clpc.appraiser import blocks, row_sums, segments
 from clpc.appraiser import kernel as K
 from clpc.core.rules import is_excited
 from clpc.core.small_eigh import sym_eig
@@ -48,14 +48,13 @@ def stages(samples, first_row, windows, plan, s, upto):
     b_lo = -(-max(0, cluster * j0 - window) // size)
     n_blocks = max(0, cluster * (j0 + count - 1) // size - b_lo)
     b_mean, b_scat, b_step = np.empty((n_blocks, p)), np.empty((n_blocks, p, p)), np.empty(n_blocks)
-    t_mean, t_scat = np.empty(p), np.empty((p, p))
-    h_mean, h_scat = np.empty(p), np.empty((p, p))
-    dev, mean, scat, z = (
-        np.empty((window // size + 3, p)),
-        np.empty(p),
-        np.empty((p, p)),
-        np.empty((size, p)),
-    )
+    t_mean, t_scat = np.empty((1, p)), np.empty((1, p, p))
+    h_mean, h_scat = np.empty((1, p)), np.empty((1, p, p))
+    mean, scat, z = np.empty(p), np.empty((p, p)), np.empty((size, p))
+    seg = segments.segment_blocks(window, size)
+    chain = segments.new_chain(seg, p)
+    chained = size > cluster
+    rows = row_sums.new_row_sums(size if chained else 1, p)
     work, theta, eig = K.new_work(p), np.empty(p), np.empty(p)
     chan, lag = plan.chan[0], plan.lag[0]
     acc = 0.0
@@ -73,24 +72,36 @@ def stages(samples, first_row, windows, plan, s, upto):
         t_end = min(full_lo * size, e)
         h_start = min(max(full_hi * size, t_end), e)
         t_size, h_size = t_end - start, e - h_start
-        if t_size > 0:
-            blocks.piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
-        if h_size > 0:
-            blocks.piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
+        where = (chan, lag, first)
+        tail = (float(t_size), t_mean, t_scat, 0)
+        if t_size > 0 and chained and t_end == (start // size + 1) * size:
+            i_t = row_sums.tail_row(samples, where, start, size, rows)
+            tail = (float(t_size), rows.tail_mean, rows.tail_scat, i_t)
+        elif t_size > 0:
+            blocks.piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean[0], t_scat[0]))
+        head = (float(h_size), h_mean, h_scat, 0)
+        if h_size > 0 and chained and h_start % size == 0:
+            i_h = row_sums.head_row(samples, where, e, size, rows)
+            head = (float(h_size), rows.head_mean, rows.head_scat, i_h)
+        elif h_size > 0:
+            blocks.piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean[0], h_scat[0]))
         step = blocks.piece_step(samples, chan[0], first, (start, t_end))
         step = min(step, blocks.piece_step(samples, chan[0], first, (h_start, e)))
-        for b in range(full_lo - b_lo, full_hi - b_lo):
-            step = min(step, b_step[b])
-        acc += t_mean[0] + step
+        acc += tail[1][tail[3], 0] + head[1][head[3], 0] + step
         if upto < 3:
             continue
-        n_w = blocks.merge(
-            (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
-            (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
-            dev,
-            (mean, scat),
+        n_s, i_s, n_p, i_p, f_step = segments.full_blocks(
+            (b_mean, b_scat, b_step, b_lo, size), (full_lo, full_hi), (seg, chain)
         )
-        acc += scat[0, 0]
+        step = min(step, f_step)
+        pieces = (
+            tail,
+            (n_s, chain.suffix_mean, chain.suffix_scat, i_s),
+            (n_p, chain.prefix_mean, chain.prefix_scat, i_p),
+            head,
+        )
+        n_w = segments.merge_pieces(pieces, chain.dev, (mean, scat))
+        acc += scat[0, 0] + step
         if upto < 4:
             continue
         if upto == 4:  # the eigen-solve alone
@@ -243,8 +254,8 @@ def split(cluster: int, n: int = 60000) -> list[tuple[str, float]]:
     t = interleaved(jobs)
     out = [
         ("block statistics (once per block)", t["1"]),
-        ("tail and head pieces, quantization steps", t["2"] - t["1"]),
-        ("merge (Chan, Golub and LeVeque)", t["3"] - t["2"]),
+        ("tail and head pieces (rows chained when C < B), steps", t["2"] - t["1"]),
+        ("full blocks' sums and the merge (Chan, Golub and LeVeque)", t["3"] - t["2"]),
         ("eigen-solve sym_eig (tred2 + tql2, vectors)", t["4"] - t["3"]),
         ("rest of solve_one (scales, checks, solve_from_eig)", t["5"] - t["4"]),
         ("is_excited", t["6"] - t["5"]),

@@ -1,4 +1,4 @@
-r"""The statistics of a CLPC window's pieces: blocks, tail and head, the exact merge, the cache.
+r"""The statistics of a CLPC window's pieces: blocks, tail and head, the cache.
 
 Plain ``numba.njit(cache=True)`` functions called by :func:`clpc.appraiser.kernel.solve_windows`
 (with ``NUMBA_DISABLE_JIT=1`` they run as plain Python). Lag rows are cut into blocks
@@ -8,15 +8,11 @@ Plain ``numba.njit(cache=True)`` functions called by :func:`clpc.appraiser.kerne
     \_ computed per window _/    \_ once per block _/   \_____ computed per window ____/
 
 Each piece is summarised by its count, mean and centered scatter (two-pass,
-:func:`piece_stats`), and pieces are merged with the formula of Chan, Golub and LeVeque
-(:func:`merge`)::
-
-    n = sum n_k,   mean = sum n_k mean_k / n,
-    A = sum A_k + sum n_k (mean_k - mean)(mean_k - mean)^T
-
-Every term is centered, so offsets (positions around 1e4 rad) and long records lose no
-digits. A block's statistics are a function of its rows alone, so the blocks an earlier call
-summarised are reused bit for bit (:class:`BlockCache`).
+:func:`piece_stats`; merged by :mod:`clpc.appraiser.segments`, the tail and head chained
+row by row by :mod:`clpc.appraiser.row_sums` when ``C < B``). Every term is centered, so
+offsets (positions around 1e4 rad) and long records lose no digits. A block's statistics
+are a function of its rows alone, so the blocks an earlier call summarised are reused bit
+for bit (:class:`BlockCache`).
 """
 
 from __future__ import annotations
@@ -27,7 +23,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-__all__ = ["BlockCache", "gather_blocks", "merge", "new_cache", "piece_stats", "piece_step"]
+__all__ = ["BlockCache", "gather_blocks", "new_cache", "piece_stats", "piece_step"]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -85,58 +81,6 @@ def piece_step(samples: np.ndarray, channel: int, first: int, rows: tuple[int, i
         if d > 0 and d < best:
             best = d
     return best
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def merge(
-    blocks: tuple[np.ndarray, np.ndarray, int, int, int],
-    pieces: tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray],
-    dev: np.ndarray,
-    out: tuple[np.ndarray, np.ndarray],
-) -> float:
-    """Merge full blocks, a tail and a head piece into one window (Chan, Golub and LeVeque).
-
-    ``blocks = (b_mean (n, p), b_scat (n, p, p), lo, hi, size)``: blocks ``lo .. hi - 1``
-    of ``size`` rows; ``pieces = (t_size, t_mean, t_scat, h_size, h_mean, h_scat)``: the
-    tail (the rows before the first full block) and the head (the rows after the last);
-    a piece of size 0 is skipped. ``dev`` work space (pieces, p); ``out = (mean, scat)``.
-    Returns the row count.
-    """
-    b_mean, b_scat, lo, hi, size = blocks
-    t_size, t_mean, t_scat, h_size, h_mean, h_scat = pieces
-    mean, scat = out
-    p = mean.shape[0]
-    total = t_size + size * (hi - lo) + h_size
-    for a in range(p):
-        acc = t_size * t_mean[a] if t_size > 0 else 0.0
-        for k in range(lo, hi):
-            acc += size * b_mean[k, a]
-        if h_size > 0:
-            acc += h_size * h_mean[a]
-        mean[a] = acc / total
-    root = math.sqrt(size)
-    t_root = math.sqrt(t_size)
-    n_dev = hi - lo + 1
-    for a in range(p):
-        dev[0, a] = t_root * (t_mean[a] - mean[a]) if t_size > 0 else 0.0
-        for k in range(lo, hi):
-            dev[k - lo + 1, a] = root * (b_mean[k, a] - mean[a])
-        if h_size > 0:
-            dev[n_dev, a] = math.sqrt(h_size) * (h_mean[a] - mean[a])
-    if h_size > 0:
-        n_dev += 1
-    for a in range(p):
-        for b in range(a + 1):
-            acc = t_scat[a, b] if t_size > 0 else 0.0
-            for k in range(lo, hi):
-                acc += b_scat[k, a, b]
-            if h_size > 0:
-                acc += h_scat[a, b]
-            for k in range(n_dev):
-                acc += dev[k, a] * dev[k, b]
-            scat[a, b] = acc
-            scat[b, a] = acc
-    return float(total)
 
 
 class BlockCache(NamedTuple):

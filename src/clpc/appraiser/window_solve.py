@@ -14,13 +14,16 @@ of ``C`` (:func:`clpc.appraiser.kernel_setup.block_rows`: ``B = C`` unless ``C``
 against ``sqrt(W)``); a window is::
 
     tail: rows of s's block  +  the full blocks  +  head: rows of e's block before e
-    \_ computed per window _/    \_ once per block _/   \_____ computed per window ____/
 
 (with ``B = C`` the head is empty). The blocks are aligned to absolute row numbers, so
 the pieces of a window do not depend on how the record was chunked either.
 
-Each piece is summarised by its count, mean and centered scatter (two-pass), and pieces
-are merged with the formula of Chan, Golub and LeVeque::
+Each block is summarised once by its count, mean and centered scatter (two-pass,
+:func:`clpc.appraiser.blocks.piece_stats`); the full blocks are one suffix and one prefix
+sum of the segments of :mod:`clpc.appraiser.segments`; the tail and the head are summed
+two-pass per window, or, when ``C < B``, taken from the chained row sums of
+:mod:`clpc.appraiser.row_sums`. The (at most four) pieces are merged with the formula of
+Chan, Golub and LeVeque (:func:`clpc.appraiser.segments.merge_pieces`)::
 
     n = sum n_k,   mean = sum n_k mean_k / n,
     A = sum A_k + sum n_k (mean_k - mean)(mean_k - mean)^T
@@ -36,8 +39,10 @@ import math
 import numba
 import numpy as np
 
-from clpc.appraiser.blocks import BlockCache, gather_blocks, merge, piece_stats, piece_step
+from clpc.appraiser.blocks import BlockCache, gather_blocks, piece_stats, piece_step
 from clpc.appraiser.kernel_types import Solved, WindowPlan, Work, new_work
+from clpc.appraiser.row_sums import head_row, new_row_sums, tail_row
+from clpc.appraiser.segments import full_blocks, merge_pieces, new_chain, segment_blocks
 from clpc.core.rules import NO_TRANSFORM, SolveSettings, is_excited
 from clpc.core.small_eigh import sym_eig
 from clpc.core.solution import channel_scales, solve_from_eig, solved_matrix
@@ -124,13 +129,14 @@ def solve_windows(
     b_mean = np.empty((n_blocks, p))
     b_scat = np.empty((n_blocks, p, p))
     b_step = np.empty(n_blocks)
-    t_mean = np.empty(p)
-    t_scat = np.empty((p, p))
-    h_mean = np.empty(p)
-    h_scat = np.empty((p, p))
-    dev = np.empty((window // size + 3, p))
+    t_mean = np.empty((1, p))  # the tail piece (one row, as the pieces merge_pieces takes)
+    t_scat = np.empty((1, p, p))
+    h_mean = np.empty((1, p))  # the head piece
+    h_scat = np.empty((1, p, p))
     mean = np.empty(p)
     scat = np.empty((p, p))
+    seg = segment_blocks(window, size)
+    chained = size > cluster  # tails and heads move inside a block: chain their rows
     z = np.empty((size, p))  # the rows of one piece
     work = new_work(p)
     c_lo, c_hi = cache.span[0], cache.span[1]
@@ -144,6 +150,8 @@ def solve_windows(
             z,
             (b_mean, b_scat, b_step),
         )
+        chain = new_chain(seg, p)
+        row_sums = new_row_sums(size if chained else 1, p)
         for w in range(count):
             j = j0 + w
             e = cluster * j
@@ -169,21 +177,33 @@ def solve_windows(
             h_start = min(max(full_hi * size, t_end), e)
             t_size = t_end - start
             h_size = e - h_start
-            if t_size > 0:
-                piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean, t_scat))
-            if h_size > 0:
-                piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean, h_scat))
+            where = (chan, lag, first)
+            tail = (float(t_size), t_mean, t_scat, 0)
+            if t_size > 0 and chained and t_end == (start // size + 1) * size:
+                i_t = tail_row(samples, where, start, size, row_sums)
+                tail = (float(t_size), row_sums.tail_mean, row_sums.tail_scat, i_t)
+            elif t_size > 0:
+                piece_stats(samples, chan, lag, first, (start, t_end), z, (t_mean[0], t_scat[0]))
+            head = (float(h_size), h_mean, h_scat, 0)
+            if h_size > 0 and chained and h_start % size == 0:
+                i_h = head_row(samples, where, e, size, row_sums)
+                head = (float(h_size), row_sums.head_mean, row_sums.head_scat, i_h)
+            elif h_size > 0:
+                piece_stats(samples, chan, lag, first, (h_start, e), z, (h_mean[0], h_scat[0]))
             # the output's quantization step in the window (column 0 is y(n))
             step = piece_step(samples, chan[0], first, (start, t_end))
             step = min(step, piece_step(samples, chan[0], first, (h_start, e)))
-            for b in range(full_lo - b_lo, full_hi - b_lo):
-                step = min(step, b_step[b])
-            n_w = merge(
-                (b_mean, b_scat, full_lo - b_lo, full_hi - b_lo, size),
-                (t_size, t_mean, t_scat, h_size, h_mean, h_scat),
-                dev,
-                (mean, scat),
+            n_s, i_s, n_p, i_p, f_step = full_blocks(
+                (b_mean, b_scat, b_step, b_lo, size), (full_lo, full_hi), (seg, chain)
             )
+            step = min(step, f_step)
+            pieces = (
+                tail,
+                (n_s, chain.suffix_mean, chain.suffix_scat, i_s),
+                (n_p, chain.prefix_mean, chain.prefix_scat, i_p),
+                head,
+            )
+            n_w = merge_pieces(pieces, chain.dev, (mean, scat))
             res = solve_one(
                 scat, mean, n_w, plan, s, work, (out.theta[w, eq], out.eigenvalues[w, eq])
             )
