@@ -32,7 +32,7 @@ from numba.extending import get_cython_function_address
 sys.path.insert(0, str(Path(__file__).parent))
 from clpc_table import WINDOW, record
 
-from clpc.appraiser import blocks, row_sums, segments
+from clpc.appraiser import blocks, row_sums, segments, window_chains
 from clpc.appraiser import kernel as K
 from clpc.core.rules import is_excited
 from clpc.core.small_eigh import sym_eig
@@ -52,9 +52,8 @@ def stages(samples, first_row, windows, plan, s, upto):
     h_mean, h_scat = np.empty((1, p)), np.empty((1, p, p))
     mean, scat, z = np.empty(p), np.empty((p, p)), np.empty((size, p))
     seg = segments.segment_blocks(window, size)
-    chain = segments.new_chain(seg, p)
+    chain, rows = window_chains.chains_of(window_chains.new_chains(plan), 0)
     chained = size > cluster
-    rows = row_sums.new_row_sums(size if chained else 1, p)
     work, theta, eig = K.new_work(p), np.empty(p), np.empty(p)
     chan, lag = plan.chan[0], plan.lag[0]
     acc = 0.0

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from clpc.appraiser.kernel_setup import block_rows
-from clpc.appraiser.row_sums import head_row, new_row_sums, tail_row
-from clpc.appraiser.segments import full_blocks, merge_pieces, merge_two, new_chain, segment_blocks
+from clpc.appraiser.row_sums import RowSums, head_row, tail_row
+from clpc.appraiser.segments import ChainSums, full_blocks, merge_pieces, merge_two, segment_blocks
 
 P = 4
 
@@ -16,6 +16,18 @@ def _rows(n_rows: int, seed: int = 1) -> np.ndarray:
     """Rows with an offset of 1e4 and unit steps (digits a raw, uncentered sum would lose)."""
     rng = np.random.default_rng(seed)
     return 1e4 + rng.standard_normal((n_rows, P)).cumsum(axis=0)
+
+
+def _chain(seg: int) -> ChainSums:
+    """Segment sums holding nothing (as ``window_chains.new_chains`` gives per equation)."""
+    sums = [np.empty((seg, P)), np.empty((seg, P, P)), np.empty(seg)]
+    return ChainSums(*sums, *[a.copy() for a in sums], np.full(3, -1), np.empty(P))
+
+
+def _row_sums(size: int) -> RowSums:
+    """Row sums holding nothing (as ``window_chains.new_chains`` gives per equation)."""
+    sums = [np.empty((size, P)), np.empty((size, P, P))]
+    return RowSums(*sums, *[a.copy() for a in sums], np.full(4, -1), np.empty(P), np.empty(P))
 
 
 def _stats(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -77,7 +89,7 @@ def test_full_blocks_equal_the_rows_directly_and_do_not_depend_on_the_batch(wind
         b_lo = windows[first][1]
         b_hi = max(w[2] for w in windows[first:last])
         blocks = (b_mean[b_lo:b_hi], b_scat[b_lo:b_hi], b_step[b_lo:b_hi], b_lo, size)
-        chain = new_chain(seg, P)
+        chain = _chain(seg)
         got = {}
         for j, lo, hi in windows[first:last]:
             n_s, i_s, n_p, i_p, step = full_blocks(blocks, (lo, hi), (seg, chain))
@@ -120,7 +132,7 @@ def test_tail_and_head_rows_equal_the_rows_directly_and_do_not_depend_on_the_bat
         return lag_rows[r - 1]
 
     def pieces(starts: list[int]) -> list[tuple]:
-        sums, got = new_row_sums(size, P), []
+        sums, got = _row_sums(size), []
         for start in starts:  # in increasing order, as the kernel asks
             end = start + 3 * size
             i_t = tail_row(samples, where, start, size, sums)

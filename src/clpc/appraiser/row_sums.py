@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-__all__ = ["RowSums", "add_row", "head_row", "new_row_sums", "tail_row"]
+__all__ = ["RowSums", "add_row", "head_row", "tail_row"]
 
 #: where a lag row comes from: ``(chan (p,), lag (p,), first)`` as for ``blocks.piece_stats``
 Where = tuple[np.ndarray, np.ndarray, int]
@@ -48,20 +48,6 @@ class RowSums(NamedTuple):
     at: np.ndarray  #: (4,) int64, -1: nothing held
     z: np.ndarray  #: (p,) work space: one lag row
     dev: np.ndarray  #: (p,) work space
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def new_row_sums(size: int, p: int) -> RowSums:
-    """Empty :class:`RowSums` for blocks of ``size`` rows and ``p`` parameters."""
-    return RowSums(
-        np.empty((size, p)),
-        np.empty((size, p, p)),
-        np.empty((size, p)),
-        np.empty((size, p, p)),
-        np.full(4, -1, np.int64),
-        np.empty(p),
-        np.empty(p),
-    )
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")

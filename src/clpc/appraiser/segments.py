@@ -17,8 +17,9 @@ where a merge over every full block of every window cost ``W / B`` block terms p
 Each sum is a chain fixed by absolute block numbers and the window's own blocks, so a
 window's numbers still depend only on its rows and its position: ``run``, ``push`` in any
 chunks, ``step`` and the threads of ``n_jobs`` give the same bits. The sums of the
-segments a batch is at are held in :class:`ChainSums` (``O(L p^2)``), computed when the
-windows (in increasing order) first need them.
+segments a call is at are held in :class:`ChainSums` (``O(L p^2)``, kept by
+:class:`clpc.appraiser.window_chains.WindowChains`), computed when the windows (in
+increasing order) first need them.
 """
 
 from __future__ import annotations
@@ -35,7 +36,6 @@ __all__ = [
     "full_blocks",
     "merge_pieces",
     "merge_two",
-    "new_chain",
     "segment_blocks",
 ]
 
@@ -160,21 +160,6 @@ class ChainSums(NamedTuple):
     prefix_step: np.ndarray  #: (L,)
     at: np.ndarray  #: (3,) int64, -1: nothing held
     dev: np.ndarray  #: (p,) work space
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def new_chain(seg: int, p: int) -> ChainSums:
-    """Empty :class:`ChainSums` for segments of ``seg`` blocks and ``p`` parameters."""
-    return ChainSums(
-        np.empty((seg, p)),
-        np.empty((seg, p, p)),
-        np.empty(seg),
-        np.empty((seg, p)),
-        np.empty((seg, p, p)),
-        np.empty(seg),
-        np.full(3, -1, np.int64),
-        np.empty(p),
-    )
 
 
 #: the blocks of a batch: ``(means (n, p), scatters (n, p, p), steps (n,), b_lo, size)``,

@@ -8,9 +8,10 @@ integers: the record's fixed settings, its carried state and its block cache pac
 per record into one array per type (:func:`pack_state`), and the outputs of a block of
 :data:`ROWS` updates packed into one array per type (:func:`new_outputs`); it rebuilds the
 kernel's named tuples from views of them (no copies) and runs
-:func:`~clpc.appraiser.kernel.solve_windows` and :func:`~clpc.appraiser.kernel.fsm_output`
-on one window, as ``update_windows`` does: the same functions on the same numbers, so the
-same bits.
+:func:`~clpc.appraiser.window_solve.solve_chained` and
+:func:`~clpc.appraiser.kernel.fsm_output` on one window, as ``update_windows`` does: the
+same functions on the same numbers, so the same bits; the packed state also keeps the
+chained sums (:mod:`clpc.appraiser.window_chains`) from one update to the next.
 
 Layout: every part is a contiguous run of one of the packed arrays; the integer array starts
 with the record's sizes and settings (``_H_*``) and a table of each part's offset and size
@@ -31,8 +32,9 @@ from clpc.appraiser.kernel import (
     Solved,
     WindowPlan,
     fsm_output,
-    solve_windows,
 )
+from clpc.appraiser.window_chains import chain_floats, chain_sizes, chains_in
+from clpc.appraiser.window_solve import solve_chained
 from clpc.core.rules import SolveSettings
 
 __all__ = [
@@ -56,10 +58,10 @@ ROWS = 256
 (_H_FSM_MIN_ROWS, _H_GUARD, _H_TRUST, _H_PAIRED) = range(15, 19)
 _HEADER = 19
 # the parts of the packed state, each (offset, size) in the table after the header
-(_CHAN, _LAG, _COL, _SPAN) = range(4)  # in the integer array
-(_FLOATS, _TRANSFORM, _THETA, _C, _C_MEAN, _C_SCAT, _C_STEP) = range(4, 11)  # float array
-_HAS_MODEL = 11  # in the bool array
-_N_STATE = 12
+(_CHAN, _LAG, _COL, _SPAN, _CHAIN_AT) = range(5)  # in the integer array
+(_FLOATS, _TRANSFORM, _THETA, _C, _C_MEAN, _C_SCAT, _C_STEP, _CHAINS) = range(5, 13)  # floats
+_HAS_MODEL = 13  # in the bool array
+_N_STATE = 14
 # the outputs of a block, by type (update_row maps them onto Solved's and FsmOutput's fields)
 FLOAT_OUT = (
     "theta_estimate", "eigenvalues", "theta", "c_solved", "noise_variance", "separation",
@@ -122,19 +124,22 @@ def pack_state(
     floats = [s.min_a0_weight, s.degeneracy_ratio, s.zero_tol, s.min_output_weight]
     floats += [fs.separation_tol, fs.min_a0_weight]
     shapes = _out_shapes(setup)
-    _layout([n_eq * p, n_eq * p, p, 2], table, _CHAN)
+    _layout([n_eq * p, n_eq * p, p, 2, 7 * n_eq], table, _CHAN)
     cached = n_eq * ring * p
-    _layout([len(floats), p * p, n_eq * p, n_eq, cached, cached * p, n_eq * ring], table, _FLOATS)
+    chained = chain_floats((n_eq, p), chain_sizes(plan.window, plan.block, plan.cluster))
+    fixed = [len(floats), p * p, n_eq * p, n_eq, cached, cached * p, n_eq * ring, chained]
+    _layout(fixed, table, _FLOATS)  # the chains hold nothing yet (at = -1)
     _layout([n_eq], table, _HAS_MODEL)
     for first, keys in ((_F0, FLOAT_OUT), (_I0, INT_OUT), (_B0, BOOL_OUT)):
         _layout([int(np.prod(shapes[k], dtype=np.int64)) for k in keys], table, first)
-    int_parts = [plan.chan.ravel(), plan.lag.ravel(), plan.col_channel, cache.span]
+    chain_at = np.full(7 * n_eq, -1, np.int64)
+    int_parts = [plan.chan.ravel(), plan.lag.ravel(), plan.col_channel, cache.span, chain_at]
     ints = np.concatenate(
         [np.array(head + [0] * (_HEADER - len(head)), np.int64), table, *int_parts]
     ).astype(np.int64)
     float_parts = [plan.transform.ravel(), fsm.last_theta.ravel(), fsm.last_c]
     cache_parts = [cache.mean.ravel(), cache.scat.ravel(), cache.step.ravel()]
-    fl = np.concatenate([np.array(floats), *float_parts, *cache_parts])
+    fl = np.concatenate([np.array(floats), *float_parts, *cache_parts, np.zeros(chained)])
     return fl, ints, fsm.has_model.astype(np.bool_)
 
 
@@ -243,16 +248,9 @@ def update_row(
         h[_H_ROBUST] != 0, h[_H_TMODE], h[_H_OUT_COLS], h[_H_CHANNELS], f[0], f[1], f[2], f[3]
     )
     fs = FsmSettings(
-        h[_H_FSM_MIN_ROWS],
-        h[_H_GUARD] != 0,
-        h[_H_TRUST],
-        f[4],
-        f[5],
-        h[_H_NA],
-        h[_H_NB],
-        h[_H_NK],
-        h[_H_PAIRED] != 0,
-    )
+        h[_H_FSM_MIN_ROWS], h[_H_GUARD] != 0, h[_H_TRUST], f[4], f[5], h[_H_NA], h[_H_NB],
+        h[_H_NK], h[_H_PAIRED] != 0,
+    )  # fmt: skip
     cache = BlockCache(
         _part(fl, ints, _C_MEAN, 0).reshape((n_eq, ring, p)),
         _part(fl, ints, _C_SCAT, 0).reshape((n_eq, ring, p, p)),
@@ -273,7 +271,10 @@ def update_row(
         _row(bout, ints, _B0 + 1, row).reshape((1, n_eq)),
         _row(iout, ints, _I0 + 2, row),
     )
-    solve_windows(samples, first_row, (j, 1), plan, s, solved, cache)
+    chained = (_part(fl, ints, _CHAINS, 0), _part(ints, ints, _CHAIN_AT, base))
+    sizes = chain_sizes(h[_H_WINDOW], h[_H_BLOCK], h[_H_CLUSTER])
+    chains = chains_in(*chained, (n_eq, p), sizes)
+    solve_chained(samples, first_row, (j, 1), (plan, s), solved, cache, chains)
     n_in, n_num = h[_H_NIN], h[_H_NK] + h[_H_NB] + 1
     out = FsmOutput(
         _row(fout, ints, _F0 + 2, row).reshape(ep),

@@ -41,13 +41,14 @@ import numpy as np
 
 from clpc.appraiser.blocks import BlockCache, gather_blocks, piece_stats, piece_step
 from clpc.appraiser.kernel_types import Solved, WindowPlan, Work, new_work
-from clpc.appraiser.row_sums import head_row, new_row_sums, tail_row
-from clpc.appraiser.segments import full_blocks, merge_pieces, new_chain, segment_blocks
+from clpc.appraiser.row_sums import head_row, tail_row
+from clpc.appraiser.segments import full_blocks, merge_pieces, segment_blocks
+from clpc.appraiser.window_chains import WindowChains, chains_of, new_chains
 from clpc.core.rules import NO_TRANSFORM, SolveSettings, is_excited
 from clpc.core.small_eigh import sym_eig
 from clpc.core.solution import channel_scales, solve_from_eig, solved_matrix
 
-__all__ = ["solve_one", "solve_windows"]
+__all__ = ["solve_chained", "solve_one", "solve_windows"]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -120,6 +121,25 @@ def solve_windows(
     between consecutive samples of the window. ``cache`` (:class:`BlockCache`) supplies the
     blocks an earlier call summarised and keeps the newest (updated in place).
     """
+    solve_chained(samples, first_row, windows, (plan, s), out, cache, new_chains(plan))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def solve_chained(
+    samples: np.ndarray,
+    first_row: int,
+    windows: tuple[int, int],
+    settings: tuple[WindowPlan, SolveSettings],
+    out: Solved,
+    cache: BlockCache,
+    chains: WindowChains,
+) -> None:
+    """:func:`solve_windows` with the chained sums an earlier call left in ``chains``.
+
+    ``chains`` (:mod:`clpc.appraiser.window_chains`) is updated in place; the windows must
+    come after those of the call that left it (``step``'s updates, in order).
+    """
+    plan, s = settings
     j0, count = windows
     n_eq, p = plan.chan.shape
     window, cluster, size = plan.window, plan.cluster, plan.block
@@ -150,8 +170,7 @@ def solve_windows(
             z,
             (b_mean, b_scat, b_step),
         )
-        chain = new_chain(seg, p)
-        row_sums = new_row_sums(size if chained else 1, p)
+        chain, row_sums = chains_of(chains, eq)
         for w in range(count):
             j = j0 + w
             e = cluster * j
