@@ -22,7 +22,11 @@ Runs, all in one invocation:
   the figures and ``report.html``; warmed up on a short record first, so the plotting
   imports are not timed), against ``clpc track ... --workers N`` on the same cluster
   (``clpc_track N``: :func:`clpc.distributed.track_command.track_settings`, i.e.
-  ``track_long`` then the same report, warmed up the same way).
+  ``track_long`` then the same report, warmed up the same way);
+* the machine alone (``machine_control.py``, in a fresh process before each round): the
+  same pieces solved one after the other, then by two plain forked processes, no Dask -
+  what this machine gives two processes that minute, against which ``run_long`` on 2
+  workers is read too.
 
 Every cluster is started once per ``N``, warmed up on a short record (numba's compiled
 kernel is loaded in each worker, the report's imports in this process), then timed. The
@@ -340,6 +344,28 @@ def _show(row: dict[str, Any], n: int, ref: dict[str, Any]) -> None:
     )
 
 
+def _show_control(controls: list[dict[str, float]], rows: dict[int, list[dict[str, Any]]]) -> None:
+    """The machine control's runs, and ``run_long`` on 2 workers against it (medians)."""
+    print(
+        f"\nthe machine alone (machine_control.py: the same {controls[0]['pieces']:.0f} pieces, "
+        "no Dask, one process then two plain processes; one before each round):"
+    )
+    for c in controls:
+        print(
+            f"  sequential {c['sequential']:5.2f} s  two processes {c['parallel']:5.2f} s  "
+            f"{c['ratio']:.2f}x"
+        )
+    two = [r["wall"] for r in rows.get(2, []) if r["mode"] == "run_long"]
+    if two:
+        plain = statistics.median(c["parallel"] for c in controls)
+        print(
+            f"  median {statistics.median(c['ratio'] for c in controls):.2f}x; run_long on 2 "
+            f"workers (median {statistics.median(two):.2f} s) takes "
+            f"{statistics.median(two) / plain:.2f}x the two plain processes' wall "
+            f"(median {plain:.2f} s)"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=float, default=1e7)
@@ -374,9 +400,12 @@ def main() -> None:
         longs: list[dict[str, Any]] = []
         flags = (("--single-worker", singles), ("--single-track", tracks), ("--single-long", longs))
 
+        controls: list[dict[str, float]] = []  # the machine's own two-process speed-up
+        control_cmd = [sys.executable, str(Path(__file__).with_name("machine_control.py"))]
+
         def references() -> None:  # one run of each, each in a fresh process
-            for flag, out in flags:
-                cmd = [sys.executable, __file__, flag, str(path), "1"]
+            commands = [([sys.executable, __file__, f, str(path), "1"], out) for f, out in flags]
+            for cmd, out in [*commands, ([*control_cmd, str(path)], controls)]:
                 done = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
                 out.append(json.loads(done.stdout))
 
@@ -404,6 +433,7 @@ def main() -> None:
             f"(track_long's work in one process: CLPC.run, Parquet parts, summary; best of "
             f"{len(longs)})"
         )
+        _show_control(controls, rows)
         for runs in rows.values():
             for row in runs:
                 if row["mode"] == "run_long":
