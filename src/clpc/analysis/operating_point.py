@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from clpc.appraiser.levels import window_levels
 from clpc.appraiser.spread import (
     GAIN_SPREAD_LIMIT,
     TREND_LIMIT,
@@ -72,8 +73,7 @@ def window_means(values: Any, index: Any, rows: Any) -> np.ndarray:
             f"the windows reach samples 0..{int(k.max())} but the record has {v.size}; "
             "pass the record the trace was computed on."
         )
-    csum = np.concatenate([[0.0], np.cumsum(v - v.mean())])
-    return (csum[k + 1] - csum[k + 1 - r]) / r + v.mean()
+    return window_levels(v.reshape(-1, 1), k, r)[:, 0]
 
 
 def locality(window_ops: np.ndarray, samples: np.ndarray) -> float:

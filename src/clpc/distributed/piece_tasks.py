@@ -35,7 +35,7 @@ import numpy as np
 from clpc.appraiser import kernel
 from clpc.appraiser.decimation import Decimator
 from clpc.appraiser.inputs import as_chunk
-from clpc.appraiser.levels import window_means
+from clpc.appraiser.levels import window_levels
 from clpc.appraiser.settings import Settings
 from clpc.appraiser.state import AppraiserState
 from clpc.appraiser.trace import Trace
@@ -155,17 +155,14 @@ def _kept(raw: np.ndarray, layout: Layout, piece: Piece) -> np.ndarray:
     return np.ascontiguousarray(out[skip : skip + piece.kept[1] - piece.kept[0]])
 
 
-def _levels(y: np.ndarray, plan: RecordPlan, piece: Piece, rows: np.ndarray) -> np.ndarray:
+def _levels(y: np.ndarray, plan: RecordPlan, piece: Piece, trace: Trace) -> np.ndarray:
     """Each window's mean output, as :func:`clpc.appraiser.levels.attach_levels` defines it.
 
     Summed within the piece (about its own mean), so the values agree with the
     single-process ones to rounding, not bit for bit.
     """
-    lay, lo = plan.layout, piece.raw[0]
-    index = lay.max_lag + lay.cluster * np.arange(piece.j_lo, piece.j_hi + 1) - 1
-    last = np.minimum(index * lay.factor, plan.n_raw - 1)
-    first = np.minimum(np.maximum((index - rows + 1) * lay.factor, 0), last)
-    return window_means(y, first - lo, last - lo)
+    span = (piece.raw[0], plan.n_raw)
+    return window_levels(y, trace.index, trace.rows, plan.layout.factor, span)
 
 
 def _peaks(columns: list[np.ndarray]) -> np.ndarray:
@@ -229,7 +226,7 @@ def solve_piece(
     accepted = trace.arrays["accepted"]
     first = np.where(accepted.any(axis=0), accepted.argmax(axis=0), -1)
     if plan.levels:
-        trace.meta["window_level"] = _levels(y, plan, piece, trace.rows)
+        trace.meta["window_level"] = _levels(y, plan, piece, trace)
         if mapped is not None:  # the second extra array
             mapped.extra[1][lo:hi] = trace.meta["window_level"]
     peaks = _peaks([u[:, k] for k in range(u.shape[1])] + [y[:, k] for k in range(y.shape[1])])
