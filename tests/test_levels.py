@@ -96,3 +96,9 @@ def test_operating_point_window_means_are_the_cumsum_formula_and_check_the_recor
     np.testing.assert_array_equal(window_means(v, index, rows), ref)
     with pytest.raises(ValueError, match="the record has 2999"):
         window_means(v[:-1], index, rows)
+
+
+def test_window_levels_refuse_a_window_outside_the_samples():
+    _, y = _record(1000, 1)
+    with pytest.raises(ValueError, match="outside the samples"):
+        window_levels(y[500:], np.array([700]), np.array([300]), 1, (500, 1000))  # from 401

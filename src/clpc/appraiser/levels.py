@@ -46,6 +46,8 @@ def _window_means(
         last = min(index[i] * factor, n_raw - 1)
         first = min(max((index[i] - rows[i] + 1) * factor, 0), last) - offset
         last -= offset
+        if first < 0 or last >= column.shape[0]:
+            raise ValueError("clpc internal error: a window reaches outside the samples given")
         if first < k_lo:
             k_lo, s_lo = 0, 0.0
         while k_lo < first:
@@ -84,7 +86,12 @@ def window_levels(
         The decimation factor ``f`` (1: none).
     span : (int, int), optional
         ``(offset, n_raw)``: the record sample of ``y[0]`` and the record's length (a piece
-        of a longer record); default ``(0, T)``. Every window must lie inside ``y``.
+        of a longer record); default ``(0, T)``.
+
+    Raises
+    ------
+    ValueError
+        A window reaches outside ``y`` (the caller's windows do not belong to these samples).
 
     Returns
     -------
