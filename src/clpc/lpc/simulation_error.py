@@ -181,26 +181,34 @@ class SimulationError:
 
         ``d y_hat / d a_l = -y_hat(n-l) / A(q)`` (measured ``y`` before the run's start,
         zero initial state), ``d y_hat / d b = u(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``.
+        Each block's columns are filtered at once and written straight into the result, run
+        after run: the record-sized arrays are the columns, the filter's output and the result
+        (the padding past a shorter run's end is filtered too, and never read).
         """
         a, runs = self._runs(x)
-        signal, parts = _signal(), []
+        signal = _signal()
+        jac = np.empty((self._times.size, self.na + self.phi_u.shape[1] + 1))
+        row = 0
         for block, y_hat in zip(self._blocks, runs, strict=True):
             n_rows, n_runs = y_hat.shape
-            y_hat = np.where(block.valid, y_hat, 0.0)
             full = np.vstack([self._past(block.starts)[::-1], y_hat])  # (na + L, R)
-            lags = [full[self.na - lag : self.na - lag + n_rows] for lag in range(1, self.na + 1)]
-            cols = np.concatenate(
-                [-np.stack(lags, axis=2), self.phi_u[block.pos], np.ones((n_rows, n_runs, 1))],
-                axis=2,
-            )
-            parts.append(-block.rows(signal.lfilter([1.0], a, cols, axis=0)))
-        return np.concatenate(parts)
+            cols = np.empty((n_rows, n_runs, jac.shape[1]))
+            for lag in range(1, self.na + 1):
+                np.negative(full[self.na - lag : self.na - lag + n_rows], out=cols[:, :, lag - 1])
+            cols[:, :, self.na : -1] = self.phi_u[block.pos]
+            cols[:, :, -1] = 1.0
+            filtered = signal.lfilter([1.0], a, cols, axis=0)
+            for r, length in enumerate(block.valid.sum(axis=0)):
+                np.negative(filtered[:length, r], out=jac[row : row + length])
+                row += length
+        return jac
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """``d residual / d x`` (``x = [rho; b; k]``: the chain rule through ``a(rho)``)."""
         _, da_drho, _, _ = self.split(x)
         jac = self.monic_jacobian(x)
-        return np.hstack([jac[:, : self.na] @ da_drho, jac[:, self.na :]])
+        jac[:, : self.na] = jac[:, : self.na] @ da_drho
+        return jac
 
     def covariance(self, x: np.ndarray, lmap: np.ndarray) -> tuple[np.ndarray, int]:
         """Covariance of the monic vector of this output at the optimum ``x`` (see OE).
