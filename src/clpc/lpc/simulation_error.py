@@ -181,9 +181,10 @@ class SimulationError:
 
         ``d y_hat / d a_l = -y_hat(n-l) / A(q)`` (measured ``y`` before the run's start,
         zero initial state), ``d y_hat / d b = u(n-nk-l) / A(q)``, ``d y_hat / d k = 1 / A(q)``.
-        Each block's columns are filtered at once and written straight into the result, run
-        after run: the record-sized arrays are the columns, the filter's output and the result
-        (the padding past a shorter run's end is filtered too, and never read).
+        Each block's columns are filled in place, filtered at once, and the filter's output
+        is written straight into the result, run after run: no stacked, masked or
+        concatenated copies (the padding past a shorter run's end is filtered too, and never
+        read).
         """
         a, runs = self._runs(x)
         signal = _signal()
