@@ -138,6 +138,9 @@ def test_settings_are_checked():
         OE(segments=0).fit(u, y)
     with pytest.raises(ValueError, match="full_run must be True or False; got 1"):
         OE(full_run=1).fit(u, y)
+    for bad in (0.0, 1.0, 1, -1e-10):
+        with pytest.raises(ValueError, match="tolerance must be a float in"):
+            OE(tolerance=bad).fit(u, y)
     with pytest.raises(ValueError, match="starts"):
         OE(starts=("n4sid",)).fit(u, y)
     with pytest.raises(ValueError, match="starts"):
@@ -227,3 +230,15 @@ def test_the_cancelled_coefficients_have_no_variance_and_the_others_keep_theirs(
     assert width[2] == 0.0 and width[6] == 0.0
     assert np.all(width[[0, 1, 3, 4, 5]] > 0.0)
     np.testing.assert_allclose((lo + hi) / 2, np.r_[model.den[1:], model.num], atol=1e-12)
+
+
+def test_a_looser_tolerance_stops_earlier_at_the_same_optimum():
+    """identify's errors-in-variables check fits OE to 1e-10: fewer evaluations, same fit."""
+    u, _, y = _record(11, n=3000, noise=1.0)
+    tight = OE(order=2, uncertainty=False, assess=False).fit(u, y)
+    loose = OE(order=2, uncertainty=False, assess=False, tolerance=1e-10).fit(u, y)
+    nfev = [int(np.ravel(m.info["nfev"])[0]) for m in (loose, tight)]
+    cost = [float(np.ravel(m.info["cost"])[0]) for m in (loose, tight)]
+    assert nfev[0] < nfev[1]  # measured: 8 and 9
+    assert cost[0] == pytest.approx(cost[1], rel=1e-9)
+    np.testing.assert_allclose(loose.theta, tight.theta, atol=1e-6)  # measured: 1.6e-8

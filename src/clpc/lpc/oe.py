@@ -78,6 +78,12 @@ class OE:
         ``N = 4`` such a pair (a pole at 0.99999, its zero 1e-4 away) left a free run of
         -23.8 % on the rest of the record, where least squares fits 86.3 % (with the
         cancellation: 87.3 %).
+    tolerance : float
+        When the search stops: the cost's relative change, the step's relative size and the
+        gradient below it (``scipy.optimize.least_squares``' ``ftol``, ``xtol`` and
+        ``gtol``; ``0 < tolerance < 1``). The default, 1e-14, asks for the optimum to about
+        machine precision; a fit that only feeds a comparison at a few per cent can stop
+        earlier (``identify``'s errors-in-variables check uses 1e-10).
     starts : tuple of {"arx", "lpc"}
         The closed-form fits that start the search (default both).
     initial : LinearModel, optional
@@ -111,6 +117,7 @@ class OE:
     nk: int = 0
     mimo: MimoMode | None = None
     max_nfev: int = 200
+    tolerance: float = 1e-14
     segments: int = SEGMENTS
     full_run: bool = True
     cancel: bool = True
@@ -146,6 +153,10 @@ class OE:
         """
         if not isinstance(self.max_nfev, int) or self.max_nfev < 1:
             raise ValueError(f"max_nfev must be an int >= 1; got {self.max_nfev!r}.")
+        if not (isinstance(self.tolerance, float) and 0.0 < self.tolerance < 1.0):
+            raise ValueError(
+                f"tolerance must be a float in (0, 1), e.g. 1e-10; got {self.tolerance!r}."
+            )
         if not isinstance(self.full_run, bool):
             raise ValueError(f"full_run must be True or False; got {self.full_run!r}.")
         if not isinstance(self.segments, int) or self.segments < 1:
@@ -181,7 +192,7 @@ class OE:
             fits = {}
             for name, model in starts.items():
                 x0 = oe_search.start_vector(model, j, list(cols), structure)
-                res = oe_search.search(prob, x0, self.max_nfev)
+                res = oe_search.search(prob, x0, (self.max_nfev, self.tolerance))
                 if np.isfinite(res.cost):
                     fits[name] = res
             if not fits:
@@ -194,7 +205,7 @@ class OE:
             solved, x_opt, cancelled = prob, fits[best].x, 0
             if self.cancel:
                 kept = oe_search.without_near_pairs(
-                    prob, x_opt, data, list(cols), structure, self.max_nfev
+                    prob, x_opt, data, list(cols), structure, (self.max_nfev, self.tolerance)
                 )
                 if kept is not None:
                     solved, x_opt, cancelled = kept

@@ -33,19 +33,24 @@ __all__ = [
 ]
 
 
-def search(prob: SimulationError, x0: np.ndarray, max_nfev: int) -> Any:
-    """Levenberg-Marquardt on ``prob`` from ``x0`` (``scipy.optimize.least_squares``)."""
+def search(prob: SimulationError, x0: np.ndarray, limits: tuple[int, float]) -> Any:
+    """Levenberg-Marquardt on ``prob`` from ``x0`` (``scipy.optimize.least_squares``).
+
+    ``limits = (max_nfev, tolerance)``: the most residual evaluations, and the relative
+    change of the cost, size of the step and gradient below which it stops.
+    """
     from scipy import optimize  # imported when used (as scipy.signal: ~0.8 s)
 
+    max_nfev, tol = limits
     return optimize.least_squares(
         prob.residual,
         x0,
         jac=prob.jacobian,
         method="lm",
         x_scale="jac",
-        xtol=1e-14,
-        ftol=1e-14,
-        gtol=1e-14,
+        xtol=tol,
+        ftol=tol,
+        gtol=tol,
         max_nfev=max_nfev,
     )
 
@@ -78,7 +83,7 @@ def without_near_pairs(
     data: IOData,
     cols: list[int],
     structure: Structure,
-    max_nfev: int,
+    limits: tuple[int, float],
 ) -> tuple[SimulationError, np.ndarray, int] | None:
     """The fit without its near pole/zero pairs, refitted at the lower order (or ``None``).
 
@@ -87,7 +92,8 @@ def without_near_pairs(
     at ``(na - m, nb - m)`` from what is left, on the same runs. The lower order is kept
     when its objective fit % (:func:`objective_fit`) is within
     :data:`~clpc.lpc.reduction.KEEP_FIT_POINTS` of the fitted order's, or better (the rule
-    of LPC's reduction). Returns the lower-order problem, its optimum and ``m``.
+    of LPC's reduction). ``limits``: the search's, as for :func:`search`. Returns the
+    lower-order problem, its optimum and ``m``.
     """
     a, _, b, _ = prob.split(x)
     nb, nk = structure.nb, structure.nk
@@ -104,7 +110,7 @@ def without_near_pairs(
         prob.full_run,
     )
     x0 = np.concatenate([start_rho(den), red[:, nk:].ravel(), [0.0]])
-    res = search(small, x0, max_nfev)
+    res = search(small, x0, limits)
     if not np.isfinite(res.cost):
         return None
     if objective_fit(small, res.x) < objective_fit(prob, x) - KEEP_FIT_POINTS:
